@@ -1,0 +1,322 @@
+//! `runout simulate CONFIG.toml [flags]`: mechanistic force simulation with runout.
+
+use crate::output;
+use anyhow::{Context, Result};
+use runout_core::{tooth_peaks, ArcChip, ForceModel, ForceSeries, ToothPeak};
+use runout_io::config::simulate::{resolve_simulate, simulate_key_names, SimulateCase};
+use runout_io::config::{layer_from_toml, Layer, Settings, Value};
+use serde_json::json;
+use std::path::PathBuf;
+
+/// Flags of `runout simulate`. Every config key is also a flag; flags override the file.
+/// Values may carry a unit suffix of the right quantity (`--runout-um 0.008mm`, `--diameter-mm 10mm`).
+#[derive(clap::Args, Debug, Default)]
+pub struct CaseFlags {
+    /// Number of teeth K.
+    #[arg(long, allow_hyphen_values = true)]
+    pub teeth: Option<String>,
+    /// Cutter diameter D (mm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub diameter_mm: Option<String>,
+    /// Helix angle (deg); 0 for straight flutes.
+    #[arg(long, allow_hyphen_values = true)]
+    pub helix_deg: Option<String>,
+    /// Variable pitch angles (deg), K comma-separated values summing to 360.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pitch_deg: Option<String>,
+    /// Flute length (mm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub flute_length_mm: Option<String>,
+    /// Spindle speed (rpm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub rpm: Option<String>,
+    /// Feed per tooth f_z (mm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub fz_mm: Option<String>,
+    /// Axial depth of cut a_p (mm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub ap_mm: Option<String>,
+    /// Radial depth of cut a_e (mm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub ae_mm: Option<String>,
+    /// Milling mode: up | down | slot.
+    #[arg(long, allow_hyphen_values = true)]
+    pub mode: Option<String>,
+    /// Explicit entry immersion angle (deg), instead of --ae-mm/--mode.
+    #[arg(long, allow_hyphen_values = true)]
+    pub entry_deg: Option<String>,
+    /// Explicit exit immersion angle (deg).
+    #[arg(long, allow_hyphen_values = true)]
+    pub exit_deg: Option<String>,
+    /// Runout offset ρ (µm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub runout_um: Option<String>,
+    /// Runout angle λ (deg), from tooth 0 in the direction of rotation.
+    #[arg(long, allow_hyphen_values = true)]
+    pub runout_angle_deg: Option<String>,
+    /// Runout tilt |τ| (µm per mm of height above the tip).
+    #[arg(long, allow_hyphen_values = true)]
+    pub tilt_um_per_mm: Option<String>,
+    /// Tilt direction in the spindle frame (deg).
+    #[arg(long, allow_hyphen_values = true)]
+    pub tilt_angle_deg: Option<String>,
+    /// Tangential shear coefficient K_tc (N/mm²).
+    #[arg(long, allow_hyphen_values = true)]
+    pub ktc: Option<String>,
+    /// Radial shear coefficient K_rc (N/mm²).
+    #[arg(long, allow_hyphen_values = true)]
+    pub krc: Option<String>,
+    /// Axial shear coefficient K_ac (N/mm²).
+    #[arg(long, allow_hyphen_values = true)]
+    pub kac: Option<String>,
+    /// Tangential edge coefficient K_te (N/mm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub kte: Option<String>,
+    /// Radial edge coefficient K_re (N/mm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub kre: Option<String>,
+    /// Axial edge coefficient K_ae (N/mm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub kae: Option<String>,
+}
+
+/// Arguments of `runout simulate`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Case file (TOML) with the keys of the flags below (e.g. `diameter_mm = 10`). Optional: a
+    /// case can be given by flags alone.
+    pub config: Option<PathBuf>,
+    #[command(flatten)]
+    pub case: CaseFlags,
+    /// Spindle revolutions to simulate (count).
+    #[arg(long, allow_hyphen_values = true)]
+    pub revolutions: Option<String>,
+    /// Angular step (deg).
+    #[arg(long, allow_hyphen_values = true)]
+    pub step_deg: Option<String>,
+    /// Number of axial disks (count).
+    #[arg(long, allow_hyphen_values = true)]
+    pub disks: Option<String>,
+    /// Chip-thickness model: arc.
+    #[arg(long, allow_hyphen_values = true)]
+    pub chip_model: Option<String>,
+    /// Write the force time series as CSV (time_s, angle_deg, fx_N, fy_N, fz_N, torque_Nm, h<i>_mm); `-` for stdout.
+    #[arg(long, allow_hyphen_values = true)]
+    pub out: Option<PathBuf>,
+    /// Write the JSON summary (inputs, per-tooth peaks, mean forces); `-` for stdout.
+    #[arg(long, allow_hyphen_values = true)]
+    pub json: Option<PathBuf>,
+    /// Plot forces vs spindle angle with each tooth's peak marked (.svg or .png).
+    #[arg(long, allow_hyphen_values = true)]
+    pub plot: Option<PathBuf>,
+}
+
+impl CaseFlags {
+    /// The flags that were given, as a settings layer.
+    pub fn layer(&self, extra: &[(&str, &Option<String>)]) -> Layer {
+        let c = self;
+        let pairs: Vec<(&str, &Option<String>)> = vec![
+            ("teeth", &c.teeth),
+            ("diameter_mm", &c.diameter_mm),
+            ("helix_deg", &c.helix_deg),
+            ("pitch_deg", &c.pitch_deg),
+            ("flute_length_mm", &c.flute_length_mm),
+            ("rpm", &c.rpm),
+            ("fz_mm", &c.fz_mm),
+            ("ap_mm", &c.ap_mm),
+            ("ae_mm", &c.ae_mm),
+            ("mode", &c.mode),
+            ("entry_deg", &c.entry_deg),
+            ("exit_deg", &c.exit_deg),
+            ("runout_um", &c.runout_um),
+            ("runout_angle_deg", &c.runout_angle_deg),
+            ("tilt_um_per_mm", &c.tilt_um_per_mm),
+            ("tilt_angle_deg", &c.tilt_angle_deg),
+            ("ktc", &c.ktc),
+            ("krc", &c.krc),
+            ("kac", &c.kac),
+            ("kte", &c.kte),
+            ("kre", &c.kre),
+            ("kae", &c.kae),
+        ];
+        let values = pairs
+            .into_iter()
+            .chain(extra.iter().copied())
+            .filter_map(|(k, v)| v.as_ref().map(|v| (k.to_string(), Value::Text(v.clone()))))
+            .collect();
+        Layer {
+            origin: "command line".into(),
+            values,
+        }
+    }
+}
+
+/// Settings from an optional TOML file overlaid by flags.
+pub fn settings(
+    config: Option<&std::path::Path>,
+    flags: Layer,
+    known: &[&str],
+) -> Result<Settings> {
+    let mut s = Settings::new();
+    if let Some(path) = config {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("reading config {}", path.display()))?;
+        s.push(layer_from_toml(&path.display().to_string(), &text, known)?);
+    }
+    s.push(flags);
+    Ok(s)
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let flags = a.case.layer(&[
+        ("revolutions", &a.revolutions),
+        ("step_deg", &a.step_deg),
+        ("disks", &a.disks),
+        ("chip_model", &a.chip_model),
+    ]);
+    let s = settings(a.config.as_deref(), flags, &simulate_key_names())?;
+    let case = resolve_simulate(&s)?;
+    let inputs: Vec<&std::path::Path> = a.config.iter().map(|p| p.as_path()).collect();
+    for out in [&a.out, &a.json, &a.plot].into_iter().flatten() {
+        output::check_not_input(out, &inputs)?;
+    }
+
+    let model = ForceModel {
+        cutter: case.cutter.clone(),
+        runout: case.runout,
+        cut: case.cut,
+        coefficients: case.coefficients,
+    };
+    let chip = ArcChip::new(&case.cutter, &case.runout, case.cut.fz())?;
+    let series = model.simulate(&chip, &case.sampling);
+    let peaks = tooth_peaks(&series, &case.cutter, &case.cut);
+
+    if let Some(out) = &a.out {
+        write_csv(out, &series)?;
+    }
+    let summary = summary_json(&case, &series, &peaks);
+    if let Some(j) = &a.json {
+        output::write_text(j, &(serde_json::to_string_pretty(&summary)? + "\n"))?;
+    }
+    if let Some(p) = &a.plot {
+        runout_io::plot::force_plot(
+            p,
+            &series,
+            &peaks,
+            "runout simulate: forces on the workpiece",
+        )?;
+    }
+    let to_stdout = |p: &Option<PathBuf>| p.as_deref() == Some(std::path::Path::new("-"));
+    if !to_stdout(&a.json) && !to_stdout(&a.out) {
+        print_text(&case, &series, &peaks);
+    }
+    Ok(())
+}
+
+fn write_csv(dest: &std::path::Path, s: &ForceSeries) -> Result<()> {
+    use std::io::Write;
+    let mut w = output::create(dest)?;
+    let k = s.chip.len();
+    write!(w, "time_s,angle_deg,fx_N,fy_N,fz_N,torque_Nm")?;
+    for i in 0..k {
+        write!(w, ",h{i}_mm")?;
+    }
+    writeln!(w)?;
+    for q in 0..s.len() {
+        write!(
+            w,
+            "{:.9},{:.4},{:.6},{:.6},{:.6},{:.6}",
+            s.time[q],
+            s.angle[q].to_degrees(),
+            s.fx[q],
+            s.fy[q],
+            s.fz[q],
+            s.torque[q]
+        )?;
+        for i in 0..k {
+            write!(w, ",{:.7}", s.chip[i][q])?;
+        }
+        writeln!(w)?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
+/// JSON summary, schema `runout.simulate/1`: inputs echoed with units in the names.
+pub fn summary_json(
+    case: &SimulateCase,
+    s: &ForceSeries,
+    peaks: &[ToothPeak],
+) -> serde_json::Value {
+    let c = &case.cutter;
+    let cut = &case.cut;
+    let (st, ex) = cut.immersion(c);
+    let k = &case.coefficients;
+    let m = s.means();
+    json!({
+        "schema": "runout.simulate/1",
+        "inputs": {
+            "teeth": c.teeth(),
+            "diameter_mm": c.diameter(),
+            "helix_deg": c.helix().to_degrees(),
+            "pitch_deg": c.pitch().iter().map(|p| p.to_degrees()).collect::<Vec<_>>(),
+            "rpm": cut.rpm(),
+            "fz_mm": cut.fz(),
+            "ap_mm": cut.ap(),
+            "entry_deg": st.to_degrees(),
+            "exit_deg": ex.to_degrees(),
+            "runout_um": case.runout.offset_um(),
+            "runout_angle_deg": case.runout.angle().to_degrees(),
+            "tilt_um_per_mm": [case.runout.tilt()[0] * 1e3, case.runout.tilt()[1] * 1e3],
+            "ktc_N_per_mm2": k.ktc, "krc_N_per_mm2": k.krc, "kac_N_per_mm2": k.kac,
+            "kte_N_per_mm": k.kte, "kre_N_per_mm": k.kre, "kae_N_per_mm": k.kae,
+            "revolutions": case.sampling.revolutions,
+            "step_deg": case.sampling.step.to_degrees(),
+            "disks": case.sampling.disks,
+            "chip_model": case.chip_model,
+        },
+        "tooth_radii_mm": case.runout.tooth_radii(c, 0.0),
+        "mean_fx_N": m[0], "mean_fy_N": m[1], "mean_fz_N": m[2], "mean_torque_Nm": m[3],
+        "tooth_peaks": peaks.iter().map(|p| json!({
+            "tooth": p.tooth,
+            "peak_fxy_N": p.peak_fxy,
+            "spindle_angle_deg": p.angle.to_degrees(),
+            "immersion_deg": p.immersion.to_degrees(),
+            "max_chip_mm": p.max_chip,
+            "own_peak_fxy_N": p.own_peak_fxy,
+        })).collect::<Vec<_>>(),
+        "samples": s.len(),
+    })
+}
+
+fn print_text(case: &SimulateCase, s: &ForceSeries, peaks: &[ToothPeak]) {
+    let m = s.means();
+    println!(
+        "runout simulate: K = {}, D = {} mm, {} rpm, f_z = {} mm, a_p = {} mm, runout {:.2} µm at {:.1}°",
+        case.cutter.teeth(),
+        case.cutter.diameter(),
+        case.cut.rpm(),
+        case.cut.fz(),
+        case.cut.ap(),
+        case.runout.offset_um(),
+        case.runout.angle().to_degrees()
+    );
+    println!(
+        "{} samples; mean F_x {:.2} N, F_y {:.2} N, F_z {:.2} N, torque {:.4} N·m",
+        s.len(),
+        m[0],
+        m[1],
+        m[2],
+        m[3]
+    );
+    println!("tooth  peak |F_xy| (N)  at spindle angle (deg)  max chip (µm)");
+    for p in peaks {
+        println!(
+            "{:>5}  {:>16.3}  {:>22.2}  {:>13.3}",
+            p.tooth,
+            p.peak_fxy,
+            p.angle.to_degrees(),
+            p.max_chip * 1e3
+        );
+    }
+}

@@ -1,0 +1,40 @@
+//! `runout`: command-line program for cutter runout in milling. A thin layer over `runout-core`
+//! (model and methods) and `runout-io` (formats): parse arguments, read, call, write.
+
+mod cmd;
+mod output;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Cutter runout in milling: simulate, identify, compensate.
+///
+/// Units: lengths mm (runout µm), forces N, time s, angles deg, speed rpm. Conventions:
+/// shared/spec/conventions.md (teeth in cutting order, runout angle from tooth 0 in the
+/// direction of rotation, forces acting on the workpiece).
+#[derive(Parser, Debug)]
+#[command(name = "runout", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
+    Simulate(cmd::simulate::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Simulate(a) => cmd::simulate::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}

@@ -1,0 +1,59 @@
+//! Errors of the pure library: every one names the parameter and what was expected.
+
+use thiserror::Error;
+
+/// A model or method parameter that is out of its valid range.
+///
+/// ```
+/// use runout_core::Cutter;
+/// let err = Cutter::flat(-1.0, 4, 30.0).unwrap_err();
+/// assert!(err.to_string().contains("diameter_mm"));
+/// ```
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("invalid parameter `{param}`: expected {expected}, got {got}")]
+pub struct ParamError {
+    /// Name of the parameter, as used in configs and flags (with its unit suffix).
+    pub param: String,
+    /// What a valid value looks like.
+    pub expected: String,
+    /// The offending value, rendered.
+    pub got: String,
+}
+
+impl ParamError {
+    /// Build an error for parameter `param`.
+    pub fn new(param: impl Into<String>, expected: impl Into<String>, got: impl ToString) -> Self {
+        ParamError {
+            param: param.into(),
+            expected: expected.into(),
+            got: got.to_string(),
+        }
+    }
+}
+
+/// Check that `value` is finite and strictly positive.
+pub(crate) fn positive(param: &str, value: f64) -> Result<f64, ParamError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(ParamError::new(param, "a finite number > 0", value))
+    }
+}
+
+/// Check that `value` is finite and non-negative.
+pub(crate) fn non_negative(param: &str, value: f64) -> Result<f64, ParamError> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(ParamError::new(param, "a finite number >= 0", value))
+    }
+}
+
+/// Check that `value` is finite.
+pub(crate) fn finite(param: &str, value: f64) -> Result<f64, ParamError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(ParamError::new(param, "a finite number", value))
+    }
+}

@@ -1,0 +1,60 @@
+//! Per-tooth peak table: the maximum of |F_xy| within each tooth period.
+//!
+//! Tooth i's period is the part of each revolution from the moment its tip (z = 0) reaches the
+//! entry angle φ_st until tooth i+1's tip does (`conventions.md`, "Signals": per-tooth peak).
+
+use super::ForceSeries;
+use crate::angle::wrap_tau;
+use crate::cut::Cut;
+use crate::cutter::Cutter;
+
+/// Peak of one tooth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ToothPeak {
+    /// Tooth index (cutting order).
+    pub tooth: usize,
+    /// Largest |F_xy| (N) in the tooth's periods.
+    pub peak_fxy: f64,
+    /// Spindle angle θ (rad, wrapped to one turn) where it occurred.
+    pub angle: f64,
+    /// Immersion angle of the tooth's tip at the peak (rad).
+    pub immersion: f64,
+    /// Largest chip thickness of the tooth (mm), over all disks.
+    pub max_chip: f64,
+    /// Largest |F_xy| (N) of the tooth's own contribution.
+    pub own_peak_fxy: f64,
+}
+
+/// Per-tooth peaks of |F_xy| in a simulated series.
+pub fn tooth_peaks(series: &ForceSeries, cutter: &Cutter, cut: &Cut) -> Vec<ToothPeak> {
+    let k = cutter.teeth();
+    let (st, _) = cut.immersion(cutter);
+    let mut peaks: Vec<ToothPeak> = (0..k)
+        .map(|i| ToothPeak {
+            tooth: i,
+            peak_fxy: f64::NEG_INFINITY,
+            angle: f64::NAN,
+            immersion: f64::NAN,
+            max_chip: series.max_chip.get(i).copied().unwrap_or(0.0),
+            own_peak_fxy: series.own_peak_fxy.get(i).copied().unwrap_or(0.0),
+        })
+        .collect();
+    for (q, &theta) in series.angle.iter().enumerate() {
+        // the tooth whose tip entered most recently owns this sample
+        let owner = (0..k)
+            .min_by(|&a, &b| {
+                let ra = wrap_tau(theta + cutter.tooth_angle(a, 0.0) - st);
+                let rb = wrap_tau(theta + cutter.tooth_angle(b, 0.0) - st);
+                ra.total_cmp(&rb)
+            })
+            .unwrap_or(0);
+        let f = series.fx[q].hypot(series.fy[q]);
+        let p = &mut peaks[owner];
+        if f > p.peak_fxy {
+            p.peak_fxy = f;
+            p.angle = wrap_tau(theta);
+            p.immersion = wrap_tau(theta + cutter.tooth_angle(owner, 0.0));
+        }
+    }
+    peaks
+}

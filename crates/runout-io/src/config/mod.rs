@@ -1,0 +1,261 @@
+//! Configuration files (TOML) whose keys carry their unit in the name, and whose values may be
+//! plain numbers or strings with a matching unit suffix (`"8um"`). Every key also exists as a
+//! command-line flag; flags override the file.
+
+pub mod simulate;
+
+use crate::units::{parse_quantity, Quantity};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+/// A config value: a number, or a string that may carry a unit suffix.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum Value {
+    /// A TOML number.
+    Number(f64),
+    /// A TOML string such as `"8um"` or `"down"`.
+    Text(String),
+}
+
+/// Error in a configuration: names the key (and the file) and what was expected.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConfigError {
+    /// The TOML itself is malformed or has an unknown key (message includes line and column).
+    #[error("{file}: {message}")]
+    Parse {
+        /// The file.
+        file: String,
+        /// The TOML parser's message.
+        message: String,
+    },
+    /// A key has a bad value.
+    #[error("{source_name}: key `{key}`: {message}")]
+    Key {
+        /// File name or "command line".
+        source_name: String,
+        /// The key or flag.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A required key is missing everywhere.
+    #[error("missing `{key}` ({what}): give it in the config file or as --{flag}")]
+    Missing {
+        /// The key.
+        key: String,
+        /// The flag.
+        flag: String,
+        /// What it is.
+        what: String,
+    },
+}
+
+/// One layer of key → value settings with its origin (file name or "command line").
+#[derive(Debug, Clone, Default)]
+pub struct Layer {
+    /// Where these settings came from.
+    pub origin: String,
+    /// Key → value.
+    pub values: BTreeMap<String, Value>,
+}
+
+/// Settings from a config file overlaid by command-line flags.
+#[derive(Debug, Clone, Default)]
+pub struct Settings {
+    layers: Vec<Layer>,
+}
+
+impl Settings {
+    /// Empty settings.
+    pub fn new() -> Self {
+        Settings::default()
+    }
+
+    /// Add a layer; later layers override earlier ones.
+    pub fn push(&mut self, layer: Layer) {
+        self.layers.push(layer);
+    }
+
+    fn lookup(&self, key: &str) -> Option<(&str, &Value)> {
+        self.layers
+            .iter()
+            .rev()
+            .find_map(|l| l.values.get(key).map(|v| (l.origin.as_str(), v)))
+    }
+
+    /// True if any layer sets `key`.
+    pub fn has(&self, key: &str) -> bool {
+        self.lookup(key).is_some()
+    }
+
+    /// Number of quantity `q` under `key`, or `None` when unset.
+    pub fn quantity(&self, key: &str, q: Quantity) -> Result<Option<f64>, ConfigError> {
+        match self.lookup(key) {
+            None => Ok(None),
+            Some((origin, Value::Number(v))) => {
+                if v.is_finite() {
+                    Ok(Some(*v))
+                } else {
+                    Err(ConfigError::Key {
+                        source_name: origin.into(),
+                        key: key.into(),
+                        message: format!("{v} is not finite (expected {q})"),
+                    })
+                }
+            }
+            Some((origin, Value::Text(t))) => {
+                parse_quantity(t, q)
+                    .map(Some)
+                    .map_err(|e| ConfigError::Key {
+                        source_name: origin.into(),
+                        key: key.into(),
+                        message: e.to_string(),
+                    })
+            }
+        }
+    }
+
+    /// Required quantity.
+    pub fn require(&self, key: &str, q: Quantity, what: &str) -> Result<f64, ConfigError> {
+        self.quantity(key, q)?.ok_or_else(|| ConfigError::Missing {
+            key: key.into(),
+            flag: key.replace('_', "-"),
+            what: what.into(),
+        })
+    }
+
+    /// Quantity with a default.
+    pub fn or(&self, key: &str, q: Quantity, default: f64) -> Result<f64, ConfigError> {
+        Ok(self.quantity(key, q)?.unwrap_or(default))
+    }
+
+    /// A non-negative integer (counts such as `teeth`, `disks`).
+    pub fn count(&self, key: &str) -> Result<Option<usize>, ConfigError> {
+        match self.quantity(key, Quantity::Dimensionless)? {
+            None => Ok(None),
+            Some(v) if v >= 0.0 && v.fract() == 0.0 && v < 1e9 => Ok(Some(v as usize)),
+            Some(v) => {
+                let origin = self
+                    .lookup(key)
+                    .map(|(o, _)| o.to_string())
+                    .unwrap_or_default();
+                Err(ConfigError::Key {
+                    source_name: origin,
+                    key: key.into(),
+                    message: format!("{v} is not a whole number >= 0"),
+                })
+            }
+        }
+    }
+
+    /// A text value (e.g. `mode`).
+    pub fn text(&self, key: &str) -> Result<Option<String>, ConfigError> {
+        match self.lookup(key) {
+            None => Ok(None),
+            Some((_, Value::Text(t))) => Ok(Some(t.clone())),
+            Some((origin, Value::Number(v))) => Err(ConfigError::Key {
+                source_name: origin.into(),
+                key: key.into(),
+                message: format!("expected a word, got the number {v}"),
+            }),
+        }
+    }
+
+    /// A list of quantities: a TOML array or a comma-separated string (`"90,85,95,90"`).
+    pub fn list(&self, key: &str, q: Quantity) -> Result<Option<Vec<f64>>, ConfigError> {
+        match self.lookup(key) {
+            None => Ok(None),
+            Some((origin, Value::Number(v))) => Ok(Some(vec![*v])).and_then(|l| {
+                if v.is_finite() {
+                    Ok(l)
+                } else {
+                    Err(ConfigError::Key {
+                        source_name: origin.into(),
+                        key: key.into(),
+                        message: "not finite".into(),
+                    })
+                }
+            }),
+            Some((origin, Value::Text(t))) => t
+                .split(',')
+                .map(|p| {
+                    parse_quantity(p, q).map_err(|e| ConfigError::Key {
+                        source_name: origin.into(),
+                        key: key.into(),
+                        message: e.to_string(),
+                    })
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map(Some),
+        }
+    }
+}
+
+/// Read a TOML config file's text into a [`Layer`], accepting only `known` keys.
+///
+/// Arrays become comma-separated text (for [`Settings::list`]). Unknown keys and malformed TOML
+/// are errors naming the file, and line and column where the TOML parser gives them.
+///
+/// ```
+/// use runout_io::config::{layer_from_toml, Value};
+/// let l = layer_from_toml("a.toml", "teeth = 4\nmode = \"down\"", &["teeth", "mode"]).unwrap();
+/// assert_eq!(l.values["teeth"], Value::Number(4.0));
+/// let e = layer_from_toml("a.toml", "teth = 4", &["teeth"]).unwrap_err();
+/// assert!(e.to_string().contains("teth"));
+/// ```
+pub fn layer_from_toml(file: &str, text: &str, known: &[&str]) -> Result<Layer, ConfigError> {
+    let table: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| ConfigError::Parse {
+            file: file.into(),
+            message: e.to_string(),
+        })?;
+    let mut values = BTreeMap::new();
+    for (k, v) in table {
+        if !known.contains(&k.as_str()) {
+            let line = text
+                .lines()
+                .position(|l| l.trim_start().starts_with(k.as_str()))
+                .map(|p| p + 1);
+            let at = line.map(|l| format!(" (line {l})")).unwrap_or_default();
+            return Err(ConfigError::Parse {
+                file: file.into(),
+                message: format!("unknown key `{k}`{at}; known keys: {}", known.join(", ")),
+            });
+        }
+        let key_err = |message: String| ConfigError::Key {
+            source_name: file.into(),
+            key: k.clone(),
+            message,
+        };
+        let value = match v {
+            toml::Value::Integer(i) => Value::Number(i as f64),
+            toml::Value::Float(f) => Value::Number(f),
+            toml::Value::String(s) => Value::Text(s),
+            toml::Value::Array(a) => {
+                let parts: Result<Vec<String>, ConfigError> = a
+                    .into_iter()
+                    .map(|x| match x {
+                        toml::Value::Integer(i) => Ok(i.to_string()),
+                        toml::Value::Float(f) => Ok(f.to_string()),
+                        toml::Value::String(s) => Ok(s),
+                        other => Err(key_err(format!("array element {other} is not a number"))),
+                    })
+                    .collect();
+                Value::Text(parts?.join(","))
+            }
+            other => {
+                return Err(key_err(format!(
+                    "expected a number or a string, got {}",
+                    other.type_str()
+                )))
+            }
+        };
+        values.insert(k, value);
+    }
+    Ok(Layer {
+        origin: file.into(),
+        values,
+    })
+}

@@ -1,0 +1,275 @@
+//! Keys of a force-simulation case (`runout simulate`), their units, and their resolution into
+//! the library's model types.
+
+use super::{ConfigError, Settings};
+use crate::units::Quantity;
+use runout_core::{
+    Cut, Cutter, CuttingCoefficients, MillingMode, ParamError, RadiusProfile, Runout, Sampling,
+};
+
+/// Every key of a simulation case: (key, quantity, help). The CLI flag is `--key-with-dashes`.
+pub const SIMULATE_KEYS: &[(&str, Quantity, &str)] = &[
+    ("teeth", Quantity::Dimensionless, "number of teeth K"),
+    ("diameter_mm", Quantity::LengthMm, "cutter diameter D (mm)"),
+    (
+        "helix_deg",
+        Quantity::AngleDeg,
+        "helix angle (deg), 0 for straight flutes [default 0]",
+    ),
+    (
+        "pitch_deg",
+        Quantity::AngleDeg,
+        "variable pitch angles (deg), K values summing to 360 [default uniform]",
+    ),
+    (
+        "flute_length_mm",
+        Quantity::LengthMm,
+        "flute length (mm) [default unbounded]",
+    ),
+    ("rpm", Quantity::SpeedRpm, "spindle speed (rpm)"),
+    ("fz_mm", Quantity::LengthMm, "feed per tooth f_z (mm)"),
+    ("ap_mm", Quantity::LengthMm, "axial depth of cut a_p (mm)"),
+    (
+        "ae_mm",
+        Quantity::LengthMm,
+        "radial depth of cut a_e (mm); not needed for slot or explicit angles",
+    ),
+    ("mode", Quantity::Dimensionless, "up | down | slot"),
+    (
+        "entry_deg",
+        Quantity::AngleDeg,
+        "explicit entry immersion angle (deg), with exit_deg, instead of ae_mm/mode",
+    ),
+    (
+        "exit_deg",
+        Quantity::AngleDeg,
+        "explicit exit immersion angle (deg)",
+    ),
+    (
+        "runout_um",
+        Quantity::LengthUm,
+        "runout offset ρ (µm) [default 0]",
+    ),
+    (
+        "runout_angle_deg",
+        Quantity::AngleDeg,
+        "runout angle λ from tooth 0 in the rotation direction (deg) [default 0]",
+    ),
+    (
+        "tilt_um_per_mm",
+        Quantity::TiltUmPerMm,
+        "runout tilt |τ| (µm per mm of height) [default 0]",
+    ),
+    (
+        "tilt_angle_deg",
+        Quantity::AngleDeg,
+        "direction of the tilt in the spindle frame (deg) [default 0]",
+    ),
+    (
+        "ktc",
+        Quantity::ForcePerArea,
+        "tangential shear coefficient K_tc (N/mm²)",
+    ),
+    (
+        "krc",
+        Quantity::ForcePerArea,
+        "radial shear coefficient K_rc (N/mm²)",
+    ),
+    (
+        "kac",
+        Quantity::ForcePerArea,
+        "axial shear coefficient K_ac (N/mm²) [default 0]",
+    ),
+    (
+        "kte",
+        Quantity::ForcePerLength,
+        "tangential edge coefficient K_te (N/mm) [default 0]",
+    ),
+    (
+        "kre",
+        Quantity::ForcePerLength,
+        "radial edge coefficient K_re (N/mm) [default 0]",
+    ),
+    (
+        "kae",
+        Quantity::ForcePerLength,
+        "axial edge coefficient K_ae (N/mm) [default 0]",
+    ),
+    (
+        "revolutions",
+        Quantity::Dimensionless,
+        "spindle revolutions simulated [default 2]",
+    ),
+    (
+        "step_deg",
+        Quantity::AngleDeg,
+        "angular step (deg) [default 0.5]",
+    ),
+    (
+        "disks",
+        Quantity::Dimensionless,
+        "axial disks [default 1 without helix, 50 with]",
+    ),
+    (
+        "chip_model",
+        Quantity::Dimensionless,
+        "chip-thickness model: arc [default arc]",
+    ),
+];
+
+/// Names of all keys.
+pub fn simulate_key_names() -> Vec<&'static str> {
+    SIMULATE_KEYS.iter().map(|k| k.0).collect()
+}
+
+/// A fully resolved simulation case.
+#[derive(Debug, Clone)]
+pub struct SimulateCase {
+    /// The cutter.
+    pub cutter: Cutter,
+    /// Its runout.
+    pub runout: Runout,
+    /// Cutting conditions.
+    pub cut: Cut,
+    /// Coefficients.
+    pub coefficients: CuttingCoefficients,
+    /// Sampling.
+    pub sampling: Sampling,
+    /// Chip model name.
+    pub chip_model: String,
+}
+
+fn key_err(settings_origin: &str, e: ParamError) -> ConfigError {
+    ConfigError::Key {
+        source_name: settings_origin.into(),
+        key: e.param.clone(),
+        message: format!("expected {}, got {}", e.expected, e.got),
+    }
+}
+
+/// Resolve the settings into model types, checking every value.
+///
+/// ```
+/// use runout_io::config::{layer_from_toml, Settings, simulate::{resolve_simulate, simulate_key_names}};
+/// let text = "teeth = 4\ndiameter_mm = 10\nrpm = 3240\nfz_mm = 0.08\nap_mm = 1\nae_mm = 2\nmode = \"down\"\nktc = 1889.2\nkrc = 806.1\nrunout_um = \"8um\"";
+/// let mut s = Settings::new();
+/// s.push(layer_from_toml("case.toml", text, &simulate_key_names()).unwrap());
+/// let case = resolve_simulate(&s).unwrap();
+/// assert!((case.runout.offset() - 0.008).abs() < 1e-15);
+/// ```
+pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
+    let o = "config";
+    let teeth = s.count("teeth")?.ok_or_else(|| ConfigError::Missing {
+        key: "teeth".into(),
+        flag: "teeth".into(),
+        what: "number of teeth".into(),
+    })?;
+    if teeth == 0 {
+        return Err(ConfigError::Key {
+            source_name: o.into(),
+            key: "teeth".into(),
+            message: "expected an integer >= 1, got 0".into(),
+        });
+    }
+    let d = s.require("diameter_mm", Quantity::LengthMm, "cutter diameter")?;
+    let helix = s.or("helix_deg", Quantity::AngleDeg, 0.0)?;
+    let flute = s.or("flute_length_mm", Quantity::LengthMm, f64::INFINITY)?;
+    let cutter = match s.list("pitch_deg", Quantity::AngleDeg)? {
+        None => Cutter::new(
+            d,
+            vec![std::f64::consts::TAU / teeth as f64; teeth],
+            helix,
+            flute,
+            RadiusProfile::Flat,
+        ),
+        Some(p) => {
+            if p.len() != teeth {
+                return Err(ConfigError::Key {
+                    source_name: o.into(),
+                    key: "pitch_deg".into(),
+                    message: format!(
+                        "expected {teeth} pitch angles (one per tooth), got {}",
+                        p.len()
+                    ),
+                });
+            }
+            Cutter::new(
+                d,
+                p.iter().map(|x| x.to_radians()).collect(),
+                helix,
+                flute,
+                RadiusProfile::Flat,
+            )
+        }
+    }
+    .map_err(|e| key_err(o, e))?;
+
+    let rpm = s.require("rpm", Quantity::SpeedRpm, "spindle speed")?;
+    let fz = s.require("fz_mm", Quantity::LengthMm, "feed per tooth")?;
+    let ap = s.require("ap_mm", Quantity::LengthMm, "axial depth of cut")?;
+    let base = Cut::new(rpm, fz, ap).map_err(|e| key_err(o, e))?;
+    let cut = if s.has("entry_deg") || s.has("exit_deg") {
+        let en = s.require("entry_deg", Quantity::AngleDeg, "entry angle")?;
+        let ex = s.require("exit_deg", Quantity::AngleDeg, "exit angle")?;
+        base.angles(en.to_radians(), ex.to_radians())
+    } else {
+        let mode_text = s.text("mode")?.ok_or_else(|| ConfigError::Missing {
+            key: "mode".into(),
+            flag: "mode".into(),
+            what: "up, down or slot".into(),
+        })?;
+        let mode: MillingMode = mode_text.parse().map_err(|e| key_err(o, e))?;
+        let ae = if mode == MillingMode::Slot {
+            d
+        } else {
+            s.require("ae_mm", Quantity::LengthMm, "radial depth of cut")?
+        };
+        base.radial(ae, mode, &cutter)
+    }
+    .map_err(|e| key_err(o, e))?;
+
+    let rho = s.or("runout_um", Quantity::LengthUm, 0.0)? * 1e-3;
+    let lam = s.or("runout_angle_deg", Quantity::AngleDeg, 0.0)?;
+    let tilt = s.or("tilt_um_per_mm", Quantity::TiltUmPerMm, 0.0)? * 1e-3;
+    let tilt_ang = s.or("tilt_angle_deg", Quantity::AngleDeg, 0.0)?;
+    let runout = Runout::new(rho, lam.to_radians())
+        .and_then(|r| r.with_tilt(tilt, tilt_ang.to_radians()))
+        .map_err(|e| key_err(o, e))?;
+
+    let coefficients = CuttingCoefficients::new(
+        [
+            s.require("ktc", Quantity::ForcePerArea, "K_tc")?,
+            s.require("krc", Quantity::ForcePerArea, "K_rc")?,
+            s.or("kac", Quantity::ForcePerArea, 0.0)?,
+        ],
+        [
+            s.or("kte", Quantity::ForcePerLength, 0.0)?,
+            s.or("kre", Quantity::ForcePerLength, 0.0)?,
+            s.or("kae", Quantity::ForcePerLength, 0.0)?,
+        ],
+    )
+    .map_err(|e| key_err(o, e))?;
+
+    let revolutions = s.or("revolutions", Quantity::Dimensionless, 2.0)?;
+    let step = s.or("step_deg", Quantity::AngleDeg, 0.5)?;
+    let disks = s
+        .count("disks")?
+        .unwrap_or(if helix == 0.0 { 1 } else { 50 });
+    let sampling = Sampling::new(revolutions, step, disks).map_err(|e| key_err(o, e))?;
+    let chip_model = s.text("chip_model")?.unwrap_or_else(|| "arc".into());
+    if chip_model != "arc" {
+        return Err(ConfigError::Key {
+            source_name: o.into(),
+            key: "chip_model".into(),
+            message: format!("expected one of: arc; got `{chip_model}`"),
+        });
+    }
+    Ok(SimulateCase {
+        cutter,
+        runout,
+        cut,
+        coefficients,
+        sampling,
+        chip_model,
+    })
+}

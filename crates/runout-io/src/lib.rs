@@ -1,0 +1,10 @@
+//! # runout-io
+//!
+//! Readers and writers for `runout`: configuration files with units, recordings, toolpaths,
+//! result tables and plots. All conversion to the library's conventions
+//! (`shared/spec/conventions.md`) happens here, at the boundary.
+#![warn(missing_docs)]
+
+pub mod config;
+pub mod plot;
+pub mod units;

@@ -1,0 +1,204 @@
+//! Plots (SVG and PNG by file extension) with plotters. PNG text is rasterised from an embedded
+//! DejaVu Sans font (Bitstream Vera licence), so no system fonts are needed.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use runout_core::{ForceSeries, ToothPeak};
+use std::path::Path;
+use std::sync::Once;
+
+/// Error while plotting.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// Neither `.svg` nor `.png`.
+    #[error("{path}: plot file must end in .svg or .png")]
+    Extension {
+        /// The path.
+        path: String,
+    },
+    /// Drawing failed.
+    #[error("{path}: plotting failed: {message}")]
+    Draw {
+        /// The path.
+        path: String,
+        /// Backend message.
+        message: String,
+    },
+}
+
+static FONT: Once = Once::new();
+
+fn register_font() {
+    FONT.call_once(|| {
+        let bytes: &'static [u8] = include_bytes!("../assets/DejaVuSans.ttf");
+        // registration fails only for a malformed font, which the test suite would catch
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, bytes);
+    });
+}
+
+/// Picture format chosen by extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Scalable vector graphics.
+    Svg,
+    /// Portable network graphics.
+    Png,
+}
+
+/// Format of `path` by its extension.
+pub fn format_of(path: &Path) -> Result<Format, PlotError> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .as_deref()
+    {
+        Some("svg") => Ok(Format::Svg),
+        Some("png") => Ok(Format::Png),
+        _ => Err(PlotError::Extension {
+            path: path.display().to_string(),
+        }),
+    }
+}
+
+/// Make the embedded font available to plotters (idempotent).
+pub fn ensure_font() {
+    register_font();
+}
+
+/// Render to `path` (.svg or .png) by calling the generic drawing function `$draw(&root)`
+/// (which returns `Result<(), String>`) with the backend the extension selects.
+///
+/// Each plot is written once as a function generic over `DB: DrawingBackend`, and this macro
+/// dispatches it; plots for other methods use the same macro.
+#[macro_export]
+macro_rules! render_plot {
+    ($path:expr, $size:expr, $draw:expr) => {{
+        use plotters::prelude::IntoDrawingArea;
+        let path: &std::path::Path = $path;
+        $crate::plot::ensure_font();
+        let p = path.display().to_string();
+        match $crate::plot::format_of(path)? {
+            $crate::plot::Format::Svg => {
+                let root = plotters::prelude::SVGBackend::new(path, $size).into_drawing_area();
+                ($draw)(&root).map_err(|m: String| $crate::plot::PlotError::Draw {
+                    path: p.clone(),
+                    message: m,
+                })?;
+                root.present().map_err(|e| $crate::plot::PlotError::Draw {
+                    path: p.clone(),
+                    message: e.to_string(),
+                })
+            }
+            $crate::plot::Format::Png => {
+                let root = plotters::prelude::BitMapBackend::new(path, $size).into_drawing_area();
+                ($draw)(&root).map_err(|m: String| $crate::plot::PlotError::Draw {
+                    path: p.clone(),
+                    message: m,
+                })?;
+                root.present().map_err(|e| $crate::plot::PlotError::Draw {
+                    path: p.clone(),
+                    message: e.to_string(),
+                })
+            }
+        }
+    }};
+}
+
+/// Stringify a plotters error.
+pub fn e2s<E: std::fmt::Debug>(e: E) -> String {
+    format!("{e:?}")
+}
+
+/// Palette for teeth / channels.
+pub fn colour(i: usize) -> RGBColor {
+    const C: [RGBColor; 8] = [
+        RGBColor(31, 119, 180),
+        RGBColor(255, 127, 14),
+        RGBColor(44, 160, 44),
+        RGBColor(214, 39, 40),
+        RGBColor(148, 103, 189),
+        RGBColor(140, 86, 75),
+        RGBColor(227, 119, 194),
+        RGBColor(127, 127, 127),
+    ];
+    C[i % C.len()]
+}
+
+/// Forces vs spindle angle (deg) with each tooth's |F_xy| peak marked.
+pub fn force_plot(
+    path: &Path,
+    series: &ForceSeries,
+    peaks: &[ToothPeak],
+    title: &str,
+) -> Result<(), PlotError> {
+    render_plot!(path, (1100, 620), |root: &DrawingArea<_, Shift>| {
+        draw_forces(root, series, peaks, title)
+    })
+}
+
+fn draw_forces<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    s: &ForceSeries,
+    peaks: &[ToothPeak],
+    title: &str,
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(e2s)?;
+    let ang: Vec<f64> = s.angle.iter().map(|a| a.to_degrees()).collect();
+    let fxy = s.fxy();
+    let all = s.fx.iter().chain(&s.fy).chain(&s.fz).chain(&fxy);
+    let (lo, hi) = all.fold((0.0f64, 0.0f64), |(l, h), v| (l.min(*v), h.max(*v)));
+    let pad = 0.05 * (hi - lo).max(1e-9);
+    let x1 = ang.last().copied().unwrap_or(360.0).max(1e-9);
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..x1, (lo - pad)..(hi + pad))
+        .map_err(e2s)?;
+    chart
+        .configure_mesh()
+        .x_desc("spindle angle (deg)")
+        .y_desc("force on workpiece (N)")
+        .draw()
+        .map_err(e2s)?;
+    let series_list: [(&str, &[f64], RGBColor); 4] = [
+        ("F_x", &s.fx, colour(0)),
+        ("F_y", &s.fy, colour(1)),
+        ("F_z", &s.fz, colour(2)),
+        ("|F_xy|", &fxy, BLACK),
+    ];
+    for (name, v, c) in series_list {
+        chart
+            .draw_series(LineSeries::new(
+                ang.iter().copied().zip(v.iter().copied()),
+                c.stroke_width(1),
+            ))
+            .map_err(e2s)?
+            .label(name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
+    }
+    // mark each tooth's peak in every revolution
+    let turns = (x1 / 360.0).ceil() as usize;
+    for p in peaks.iter().filter(|p| p.angle.is_finite()) {
+        let c = colour(p.tooth + 3);
+        let pts: Vec<(f64, f64)> = (0..turns)
+            .map(|t| (p.angle.to_degrees() + 360.0 * t as f64, p.peak_fxy))
+            .filter(|(x, _)| *x <= x1)
+            .collect();
+        chart
+            .draw_series(pts.into_iter().map(|pt| Circle::new(pt, 5, c.filled())))
+            .map_err(e2s)?
+            .label(format!("tooth {} peak {:.1} N", p.tooth, p.peak_fxy))
+            .legend(move |(x, y)| Circle::new((x + 9, y), 5, c.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(e2s)?;
+    Ok(())
+}
