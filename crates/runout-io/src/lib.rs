@@ -7,4 +7,5 @@
 
 pub mod config;
 pub mod plot;
+pub mod recording;
 pub mod units;
