@@ -37,7 +37,7 @@ fn dynoware(delim: char, decimal_comma: bool, rows: usize) -> String {
     s += &format!("Time{d}Fx{d}Fy{d}Fz\n");
     s += &format!("s{d}N{d}N{d}N\n");
     for k in 0..rows {
-        s += &format!("{}", num(k as f64 * 1e-4, 4));
+        s += &num(k as f64 * 1e-4, 4);
         for c in 0..3 {
             s += &format!("{d}{}", num(value(c, k), 4));
         }
@@ -417,5 +417,50 @@ proptest! {
         prop_assert_eq!(rec.values[0][0], x);
         prop_assert_eq!(rec.values[1][0], x);
         prop_assert_eq!(rec.values[2][0], format!("{x:.6}").parse::<f64>().unwrap());
+    }
+}
+
+#[test]
+fn reads_what_the_dynoware_exporter_writes() {
+    use runout_io::export::{write_dynoware, Channel, TextStyle};
+    let fx: Vec<f64> = (0..300)
+        .map(|k| (k as f64 * 0.37).sin() * 123.456)
+        .collect();
+    let fy: Vec<f64> = (0..300).map(|k| -(k as f64 * 0.11).cos() * 7.5).collect();
+    for (delimiter, decimal_comma) in [(',', false), (';', true), ('\t', true)] {
+        let mut out = Vec::new();
+        write_dynoware(
+            &mut out,
+            25_000.0,
+            &[("Filename", "sim.dwd")],
+            &[
+                Channel {
+                    name: "Fx",
+                    unit: "N",
+                    data: &fx,
+                },
+                Channel {
+                    name: "Fy",
+                    unit: "N",
+                    data: &fy,
+                },
+            ],
+            TextStyle {
+                delimiter,
+                decimal_comma,
+            },
+        )
+        .unwrap();
+        let rec = Recording::from_bytes("sim.txt", &out, &ReadOptions::new()).unwrap();
+        assert_eq!(rec.info.sample_rate_hz, 25_000.0);
+        assert_eq!(rec.len(), 300);
+        // the exporter's text precision bounds the difference
+        let err = rec.values[0]
+            .iter()
+            .zip(&fx)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-3, "{delimiter:?}: {err}");
+        assert_eq!(rec.info.metadata_value("Filename"), Some("sim.dwd"));
     }
 }

@@ -152,7 +152,7 @@ impl<W: Write> BinaryWriter<W> {
             }
         }
         let mut text = header.to_string().into_bytes();
-        while (12 + text.len()) % 8 != 0 {
+        while !(12 + text.len()).is_multiple_of(8) {
             text.push(b' ');
         }
         let mut out = BufWriter::with_capacity(1 << 16, w);
