@@ -1,0 +1,488 @@
+//! Shank-deflection force method (issue 6, methods.md §3): stiffness worked examples, static
+//! calibration, full round trip simulate → beam deflection + air-cut pattern → force and runout,
+//! bad inputs.
+
+use proptest::prelude::*;
+use rand::{rngs::StdRng, Rng, SeedableRng};
+use rand_distr::Normal;
+use runout_core::shank::*;
+use runout_core::*;
+use std::f64::consts::{PI, TAU};
+
+fn example1() -> ShankBeam {
+    ShankBeam::new(210.0, 8.0, 65.0, 10.0, 30.0).unwrap()
+}
+
+#[test]
+fn patent_worked_examples_and_wrong_alternatives() {
+    let e1 = example1();
+    let e2 = ShankBeam::new(610.0, 12.0, 85.0, 15.0, 35.0).unwrap();
+    // patent: 1.9488 and 17.2874 N/µm (± 0.0001); methods.md §7: 1.948754, 17.287361
+    for (beam, patent, vector) in [(e1, 1.9488, 1.948754), (e2, 17.2874, 17.287361)] {
+        let k = beam.stiffness_n_per_um();
+        assert!((k - patent).abs() <= 1e-4, "{k} vs patent {patent}");
+        assert!((k - vector).abs() <= 1e-6, "{k} vs {vector}");
+        let ei = beam.modulus_n_per_mm2 * beam.second_moment_mm4();
+        // wrong alternative 1: tip stiffness 3EI/l³ (0.461 / 3.033 N/µm)
+        let tip = 3.0 * ei / beam.tool_length_mm.powi(3) / 1e3;
+        // wrong alternative 2: single-point stiffness at l_II (1.706 / 13.82 N/µm)
+        let l2 = beam.l2_mm;
+        let single = 6.0 * ei / (l2 * l2 * (3.0 * beam.tool_length_mm - l2)) / 1e3;
+        assert!((tip - patent).abs() > 0.1 * patent, "tip {tip}");
+        assert!((single - patent).abs() > 0.1 * patent, "single {single}");
+    }
+    assert!((example1().second_moment_mm4() - 201.06).abs() < 0.01);
+}
+
+#[test]
+fn load_point_and_holder_options() {
+    // methods.md §3.1: example 1 with a = 64 mm gives 1.985 N/µm (+1.9 %)
+    let mid = example1()
+        .with_load_point(LoadPoint::MidDepth {
+            axial_depth_mm: 2.0,
+        })
+        .unwrap();
+    assert!(
+        (mid.stiffness_n_per_um() - 1.985).abs() < 5e-4,
+        "{}",
+        mid.stiffness_n_per_um()
+    );
+    // holder rotation adds (l_II − l_I)·a/k_θ to the compliance
+    let k_theta = 2e7;
+    let held = example1().with_holder_stiffness(k_theta).unwrap();
+    let expect = 1.0 / (1.0 / example1().stiffness_n_per_mm() + 20.0 * 65.0 / k_theta);
+    assert!((held.stiffness_n_per_mm() - expect).abs() < 1e-9 * expect);
+    // a load point between the sensors and the tip, sensor above it: x > a branch
+    let low = example1()
+        .with_load_point(LoadPoint::At { distance_mm: 25.0 })
+        .unwrap();
+    let ei = low.modulus_n_per_mm2 * low.second_moment_mm4();
+    let c = (625.0 * (3.0 * 30.0 - 25.0) - 100.0 * (75.0 - 10.0)) / (6.0 * ei);
+    assert!((low.stiffness_n_per_mm() - 1.0 / c).abs() < 1e-9 / c);
+}
+
+#[test]
+fn bad_geometry_is_rejected_with_the_parameter_named() {
+    let e = ShankBeam::new(210.0, 8.0, 65.0, 20.0, 20.0).unwrap_err();
+    assert_eq!(e.param, "l2_mm");
+    assert!(e.expected.contains("equal heights"), "{e}");
+    let e = ShankBeam::new(210.0, 8.0, 65.0, 10.0, 70.0).unwrap_err();
+    assert_eq!(e.param, "l2_mm");
+    assert!(e.to_string().contains("tool_length_mm"), "{e}");
+    assert_eq!(
+        ShankBeam::new(210.0, 8.0, 65.0, 30.0, 10.0)
+            .unwrap_err()
+            .param,
+        "l2_mm"
+    );
+    assert_eq!(
+        ShankBeam::new(0.0, 8.0, 65.0, 10.0, 30.0)
+            .unwrap_err()
+            .param,
+        "modulus_gpa"
+    );
+    assert_eq!(
+        ShankBeam::new(210.0, -8.0, 65.0, 10.0, 30.0)
+            .unwrap_err()
+            .param,
+        "diameter_mm"
+    );
+    let e = example1()
+        .with_load_point(LoadPoint::MidDepth {
+            axial_depth_mm: 200.0,
+        })
+        .unwrap_err();
+    assert_eq!(e.param, "load_point_mm");
+}
+
+/// Δ for a load F at a on the true shank (bending scale s, holder k_θ).
+fn true_delta(beam: &ShankBeam, s: f64, k_theta: f64, f: f64, a: f64) -> f64 {
+    let ei = beam.modulus_n_per_mm2 * beam.second_moment_mm4();
+    let b =
+        ShankBeam::bending_shape_mm3(beam.l2_mm, a) - ShankBeam::bending_shape_mm3(beam.l1_mm, a);
+    f * (s * b / (6.0 * ei) + (beam.l2_mm - beam.l1_mm) * a / k_theta)
+}
+
+#[test]
+fn static_calibration_recovers_stiffness_and_holder_compliance() {
+    let beam = example1();
+    let (s_true, k_theta) = (1.03, 2e7);
+    let truth = beam.with_holder_stiffness(k_theta).unwrap();
+    let k_true = 1.0
+        / (1.0 / truth.stiffness_n_per_mm() + (s_true - 1.0) * (1.0 / beam.stiffness_n_per_mm()));
+    let mut rng = StdRng::seed_from_u64(7);
+    let noise = Normal::new(0.0, 5e-5).unwrap(); // 0.05 µm sensor noise
+    let mut steps = Vec::new();
+    for a in [35.0, 50.0, 64.0] {
+        for f in [0.0, 20.0, 40.0, 60.0, 80.0, 100.0] {
+            steps.push(LoadStep {
+                force_n: f,
+                load_point_mm: a,
+                delta_mm: 0.002 + true_delta(&beam, s_true, k_theta, f, a) + rng.sample(noise),
+            });
+        }
+    }
+    let cal = calibrate(&beam, &steps).unwrap();
+    // tolerance: 4 standard errors, and the SE itself small (noise 0.05 µm on Δ ≈ 60 µm)
+    assert!((cal.stiffness_n_per_mm - k_true).abs() < 4.0 * cal.stiffness_se_n_per_mm);
+    assert!(cal.stiffness_se_n_per_mm < 0.003 * k_true, "{cal:?}");
+    let (c, c_se) = cal.holder_compliance_rad_per_nmm.unwrap();
+    assert!(
+        (c - 1.0 / k_theta).abs() < 4.0 * c_se,
+        "{c} ± {c_se} vs {}",
+        1.0 / k_theta
+    );
+    assert!(c_se < 0.1 / k_theta, "{c_se} vs {}", 1.0 / k_theta);
+    let (s, s_se) = cal.beam_scale.unwrap();
+    assert!((s - s_true).abs() < 4.0 * s_se);
+    assert!((cal.offset_mm - 0.002).abs() < 1e-4);
+    assert!(cal.r_squared > 0.9999);
+    // one load point: K only, holder not identifiable
+    let one: Vec<LoadStep> = steps
+        .iter()
+        .copied()
+        .filter(|s| s.load_point_mm == 64.0)
+        .collect();
+    let cal1 = calibrate(
+        &beam
+            .with_load_point(LoadPoint::At { distance_mm: 64.0 })
+            .unwrap(),
+        &one,
+    )
+    .unwrap();
+    assert!(cal1.holder_compliance_rad_per_nmm.is_none());
+    let k64 = 1.0 / true_delta(&beam, s_true, k_theta, 1.0, 64.0);
+    assert!((cal1.stiffness_n_per_mm - k64).abs() < 4.0 * cal1.stiffness_se_n_per_mm);
+    // degenerate: a single force
+    let flat: Vec<LoadStep> = (0..5)
+        .map(|_| LoadStep {
+            force_n: 50.0,
+            load_point_mm: 64.0,
+            delta_mm: 0.02,
+        })
+        .collect();
+    assert!(matches!(
+        calibrate(&beam, &flat),
+        Err(ShankError::Calibration(_))
+    ));
+}
+
+/// The synthetic recording of the round trip.
+struct Synthetic {
+    columns: Vec<Vec<f64>>,
+    truth_fx: Vec<f64>,
+    truth_fy: Vec<f64>,
+    cut: (usize, usize),
+    f_true: f64,
+    e0: (f64, f64),
+    tilt: (f64, f64),
+}
+
+const FS: f64 = 20_000.0;
+const RPM: f64 = 3000.0;
+
+/// Force history from the force model (one revolution, periodic), the beam's deflections at the
+/// two sensor heights, runout offset + tilt and shank form error rotating with the spindle, gap
+/// offsets, a slow drift, 0.1 % spindle-speed error, Gaussian sensor noise; optional pulse.
+fn synthetic(air_before: f64, cut_revs: f64, air_after: f64, pulse: bool, seed: u64) -> Synthetic {
+    let cutter = Cutter::flat(8.0, 3, 30.0).unwrap();
+    let tool_runout = Runout::new(0.010, 30f64.to_radians()).unwrap();
+    let cut = Cut::new(RPM, 0.05, 2.0)
+        .unwrap()
+        .radial(2.0, MillingMode::Down, &cutter)
+        .unwrap();
+    let coefficients =
+        CuttingCoefficients::new([1889.2, 806.1, 291.0], [63.12, 113.7, -3.1]).unwrap();
+    let chip = ArcChip::new(&cutter, &tool_runout, 0.05).unwrap();
+    let model = ForceModel {
+        cutter,
+        runout: tool_runout,
+        cut,
+        coefficients,
+    };
+    let series = model.simulate(&chip, &Sampling::new(1.0, 0.2, 20).unwrap());
+    let per_rev = series.fx.len();
+    let force_at = |th: f64, v: &[f64]| {
+        let u = (th / TAU).rem_euclid(1.0) * per_rev as f64;
+        let i = u.floor() as usize % per_rev;
+        let w = u - u.floor();
+        v[i] * (1.0 - w) + v[(i + 1) % per_rev] * w
+    };
+    let beam = example1();
+    let (c1, c2) = (
+        beam.compliance_at_mm_per_n(10.0),
+        beam.compliance_at_mm_per_n(30.0),
+    );
+    let f_true = RPM / 60.0 * 1.001;
+    let total = ((air_before + cut_revs + air_after) / f_true * FS) as usize;
+    let e0 = (0.010 * (0.7f64).cos(), 0.010 * (0.7f64).sin());
+    let tilt = (0.0002 * (2.1f64).cos(), 0.0002 * (2.1f64).sin());
+    let e_at = |z: f64| (e0.0 + z * tilt.0, e0.1 + z * tilt.1);
+    let (z1, z2) = (55.0, 35.0);
+    let mut rng = StdRng::seed_from_u64(seed);
+    let noise = Normal::new(0.0, 5e-5).unwrap(); // 0.05 µm
+    let mut cols = vec![Vec::with_capacity(total); 4 + usize::from(pulse)];
+    let (mut tfx, mut tfy) = (Vec::new(), Vec::new());
+    let start = (air_before / f_true * FS) as usize;
+    let end = ((air_before + cut_revs) / f_true * FS) as usize;
+    for k in 0..total {
+        let t = k as f64 / FS;
+        let th = TAU * f_true * t;
+        let rev = th / TAU;
+        let env = if k < start || k >= end {
+            0.0
+        } else {
+            let r_in = (rev - air_before).min(air_before + cut_revs - rev);
+            (r_in / 2.0).clamp(0.0, 1.0) // 2-revolution entry and exit ramps
+        };
+        let (fx, fy) = (
+            env * force_at(th, &series.fx),
+            env * force_at(th, &series.fy),
+        );
+        tfx.push(fx);
+        tfy.push(fy);
+        let drift = 0.0005 * t / 7.0;
+        for (axis, f_wp) in [(0, fx), (1, fy)] {
+            for (h, (z, c, gap)) in [(z1, c1, 0.5), (z2, c2, 0.48)].into_iter().enumerate() {
+                let e = e_at(z);
+                // runout seen by an x sensor: Re(E e^{jθ}); by a y sensor: −Im(E e^{jθ})
+                let (re, im) = (
+                    e.0 * th.cos() - e.1 * th.sin(),
+                    e.0 * th.sin() + e.1 * th.cos(),
+                );
+                let runout = if axis == 0 { re } else { -im };
+                let form = 0.0015 * (2.0 * th + 0.3 + h as f64).cos() / (1.0 + h as f64)
+                    + 0.0005 * (3.0 * th + 1.1 * axis as f64).sin();
+                let deflection = c * (-f_wp); // force on the tool = −force on the workpiece
+                cols[2 * axis + h]
+                    .push(gap + runout + form + deflection + drift * h as f64 + rng.sample(noise));
+            }
+        }
+        if pulse {
+            cols[4].push(if rev.fract() < 0.05 { 5.0 } else { 0.0 });
+        }
+    }
+    Synthetic {
+        columns: cols,
+        truth_fx: tfx,
+        truth_fy: tfy,
+        cut: (start, end),
+        f_true,
+        e0,
+        tilt,
+    }
+}
+
+fn setup(pulse: bool) -> ShankSetup {
+    let mut s = ShankSetup::new(
+        example1(),
+        vec![
+            SensorPair {
+                axis: PairAxis::X,
+                sign: 1.0,
+            },
+            SensorPair {
+                axis: PairAxis::Y,
+                sign: 1.0,
+            },
+        ],
+        FS,
+        RPM,
+    );
+    s.has_pulse = pulse;
+    s
+}
+
+fn rms_error(est: &[f64], truth: &[f64], range: (usize, usize)) -> f64 {
+    let (mut se, mut st) = (0.0, 0.0);
+    for k in range.0..range.1 {
+        se += (est[k] - truth[k]).powi(2);
+        st += truth[k].powi(2);
+    }
+    (se / st).sqrt()
+}
+
+#[test]
+fn round_trip_force_and_runout_over_300_revolutions() {
+    for pulse in [false, true] {
+        let syn = synthetic(20.0, 300.0, 20.0, pulse, 11 + u64::from(pulse));
+        let cols: Vec<&[f64]> = syn.columns.iter().map(Vec::as_slice).collect();
+        let (analysis, out, _) = process_in_memory(&setup(pulse), &cols).unwrap();
+        assert_eq!(
+            analysis.air_segments.len(),
+            2,
+            "{:?}",
+            analysis.air_segments
+        );
+        // spindle: 0.1 % off nominal, recovered to 1e-6 relative (phase drift < 0.001 rev over 340 revolutions)
+        let f = analysis.spindle.mean_frequency_hz();
+        assert!(
+            (f / syn.f_true - 1.0).abs() < 1e-6,
+            "pulse {pulse}: f {f} vs {}",
+            syn.f_true
+        );
+        // force within 2 % RMS of the truth over the cut (sensor noise alone gives ≈ 0.2 %)
+        let ex = rms_error(&out.force_n[0], &syn.truth_fx, syn.cut);
+        let ey = rms_error(&out.force_n[1], &syn.truth_fy, syn.cut);
+        eprintln!(
+            "pulse {pulse}: relative RMS force error x {ex:.5} y {ey:.5}; f error {:.2e}; tip offset error {:.3} µm; tilt error {:.4} µm/mm",
+            f / syn.f_true - 1.0,
+            (analysis.runout.tip_offset_mm.0 - syn.e0.0).hypot(analysis.runout.tip_offset_mm.1 - syn.e0.1) * 1e3,
+            (analysis.runout.tilt.0 - syn.tilt.0).hypot(analysis.runout.tilt.1 - syn.tilt.1) * 1e3,
+        );
+        assert!(
+            ex < 0.02 && ey < 0.02,
+            "pulse {pulse}: relative RMS errors {ex} {ey}"
+        );
+        // the detected cut brackets the true one within 2 revolutions of margin
+        let c = analysis.cut.unwrap();
+        let spr = FS / syn.f_true;
+        assert!(
+            (c.start as f64) <= syn.cut.0 as f64 + 1.0
+                && (c.start as f64) > syn.cut.0 as f64 - 3.0 * spr
+        );
+        assert!(
+            (c.end as f64) >= syn.cut.1 as f64 - 1.0
+                && (c.end as f64) < syn.cut.1 as f64 + 3.0 * spr
+        );
+        // runout from the air-cut templates: offset at the tip and tilt (θ = 0 is t = 0 here,
+        // or the pulse edge, which the synthetic puts at θ = 0 too)
+        let r = &analysis.runout;
+        let (ox, oy) = r.tip_offset_mm;
+        // offset within 0.1 µm and tilt within 0.005 µm/mm per component (noise 0.05 µm averaged
+        // over 40 revolutions; the pulse edge is quantised to 1/20 kHz → ≤ 0.9° of phase)
+        let tol_o = if pulse { 0.0002 } else { 0.0001 };
+        assert!(
+            (ox - syn.e0.0).abs() < tol_o && (oy - syn.e0.1).abs() < tol_o,
+            "pulse {pulse}: {ox} {oy} vs {:?}",
+            syn.e0
+        );
+        assert!(
+            (r.tilt.0 - syn.tilt.0).abs() < 5e-6 && (r.tilt.1 - syn.tilt.1).abs() < 5e-6,
+            "{:?} vs {:?}",
+            r.tilt,
+            syn.tilt
+        );
+        assert!(r.offset_se_mm < 1e-4);
+        assert!(analysis.saturated_samples == 0);
+        assert!(analysis.warnings.is_empty(), "{:?}", analysis.warnings);
+    }
+}
+
+#[test]
+fn low_pass_keeps_the_force_and_validation_metrics_agree() {
+    let syn = synthetic(10.0, 40.0, 10.0, false, 5);
+    let mut s = setup(false);
+    s.has_reference = true;
+    // tooth frequency 150 Hz: a 2 kHz cutoff keeps the force's harmonics up to ~13×
+    s.lowpass = Some((4, 2000.0));
+    let mut cols: Vec<&[f64]> = syn.columns.iter().map(Vec::as_slice).collect();
+    cols.push(&syn.truth_fx);
+    cols.push(&syn.truth_fy);
+    let (_, out, cmp) = process_in_memory(&s, &cols).unwrap();
+    assert_eq!(out.len(), syn.truth_fx.len());
+    let cmp = cmp.unwrap();
+    let ex = rms_error(&out.force_n[0], &syn.truth_fx, syn.cut);
+    assert!(ex < 0.02, "{ex}");
+    // streaming metrics agree with the direct computation over the detected cut
+    assert!(cmp[0].relative_rms_error < 0.03, "{:?}", cmp[0]);
+    assert!(cmp[0].correlation > 0.999, "{:?}", cmp[0]);
+    assert!(
+        cmp[0].peak_error_n.abs() < 0.03 * cmp[0].rms_reference_n * 3.0,
+        "{:?}",
+        cmp[0]
+    );
+}
+
+#[test]
+fn no_air_cut_is_an_error() {
+    // the cut starts after 2 revolutions and runs to the end
+    let syn = synthetic(2.0, 40.0, 0.0, false, 3);
+    let cols: Vec<&[f64]> = syn.columns.iter().map(Vec::as_slice).collect();
+    let err = process_in_memory(&setup(false), &cols).unwrap_err();
+    assert!(matches!(err, ShankError::NoAirCut(_)), "{err}");
+    assert!(err.to_string().contains("air_cut_s"), "{err}");
+    // a given air cut that is too short
+    let mut s = setup(false);
+    s.air_cut_s = vec![(0.0, 0.03)];
+    let err = process_in_memory(&s, &cols).unwrap_err();
+    assert!(err.to_string().contains("at least 5"), "{err}");
+}
+
+#[test]
+fn saturated_samples_are_flagged_not_used() {
+    let mut syn = synthetic(10.0, 30.0, 10.0, false, 9);
+    // clip sensor II of x at its maximum over 200 samples in the middle of the cut
+    let mid = (syn.cut.0 + syn.cut.1) / 2;
+    let rail = syn.columns[1].iter().cloned().fold(f64::MIN, f64::max) + 0.001;
+    for v in &mut syn.columns[1][mid..mid + 200] {
+        *v = rail;
+    }
+    let cols: Vec<&[f64]> = syn.columns.iter().map(Vec::as_slice).collect();
+    let (analysis, out, _) = process_in_memory(&setup(false), &cols).unwrap();
+    assert_eq!(analysis.saturated_samples, 200);
+    assert!(analysis.warnings.iter().any(|w| w.contains("saturated")));
+    assert!(out.saturated[mid..mid + 200].iter().all(|&s| s));
+    assert!(out.force_n[0][mid..mid + 200].iter().all(|f| f.is_nan()));
+    assert!(!out.saturated[mid - 1] && !out.saturated[mid + 200]);
+    // explicit sensor range flags too
+    let mut s = setup(false);
+    s.sensor_range_mm = Some((-1.0, rail));
+    let (_, out, _) = process_in_memory(&s, &cols).unwrap();
+    assert!(out.force_n[0][mid].is_nan());
+}
+
+#[test]
+fn equal_sensor_heights_and_bad_setup() {
+    let mut s = setup(false);
+    s.pairs.clear();
+    assert!(matches!(Survey::new(&s), Err(ShankError::Param(p)) if p.param == "pairs"));
+    let mut s = setup(false);
+    s.nominal_rpm = 200_000.0; // 6 samples per revolution
+    assert!(matches!(Survey::new(&s), Err(ShankError::Param(p)) if p.param == "sample_rate_hz"));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// The stiffness equals the patent formula for any valid geometry with the tip load.
+    #[test]
+    fn stiffness_matches_the_closed_form(
+        e in 70.0f64..700.0, d in 3.0f64..25.0, lt in 40.0f64..150.0, f1 in 0.0f64..0.4, f2 in 0.45f64..1.0,
+    ) {
+        let (l1, l2) = (f1 * lt, f2 * lt);
+        let beam = ShankBeam::new(e, d, lt, l1, l2).unwrap();
+        let i = PI * d.powi(4) / 64.0;
+        let k = 6.0 * e * 1e3 * i / (l2 * l2 * (3.0 * lt - l2) - l1 * l1 * (3.0 * lt - l1));
+        prop_assert!((beam.stiffness_n_per_mm() - k).abs() < 1e-9 * k);
+    }
+
+    /// Static calibration is exact on noiseless steps for any holder stiffness and scale.
+    #[test]
+    fn calibration_is_exact_without_noise(s_true in 0.9f64..1.2, log_k in 6.5f64..9.0) {
+        let beam = example1();
+        let k_theta = 10f64.powf(log_k);
+        let steps: Vec<LoadStep> = [40.0, 52.0, 64.0]
+            .iter()
+            .flat_map(|&a| [10.0, 50.0, 90.0].map(move |f| (a, f)))
+            .map(|(a, f)| LoadStep { force_n: f, load_point_mm: a, delta_mm: true_delta(&beam, s_true, k_theta, f, a) })
+            .collect();
+        let cal = calibrate(&beam, &steps).unwrap();
+        let k = 1.0 / true_delta(&beam, s_true, k_theta, 1.0, 65.0);
+        prop_assert!((cal.stiffness_n_per_mm / k - 1.0).abs() < 1e-8);
+        prop_assert!((cal.holder_compliance_rad_per_nmm.unwrap().0 * k_theta - 1.0).abs() < 1e-5);
+    }
+
+    /// The spindle frequency from two air cuts is recovered for any speed error within ±1 %.
+    #[test]
+    fn spindle_frequency_from_phase_advance(err in -0.01f64..0.01, phase in 0.0f64..TAU, gap in 2.0f64..8.0) {
+        let f_true = 50.0 * (1.0 + err);
+        let sig = |t: f64| 0.004 * (TAU * f_true * t + phase).cos() + 0.001 * (2.0 * TAU * f_true * t).cos();
+        let a: Vec<f64> = (0..3000).map(|k| sig(k as f64 / FS)).collect();
+        let b: Vec<f64> = (0..3000).map(|k| sig(gap + k as f64 / FS)).collect();
+        let (f, _, _) = frequency_from_air(
+            &[PhaseSegment { x: &a, t_start: 0.0 }, PhaseSegment { x: &b, t_start: gap }], FS, 50.0);
+        // what matters is the phase propagated across the gap: < 1e-3 rad (0.06°)
+        prop_assert!(((f - f_true) * TAU * gap).abs() < 1e-3, "{} vs {}", f, f_true);
+    }
+}
