@@ -19,16 +19,21 @@ struct Cli {
     command: Command,
 }
 
+// Parsed once per run: the size difference between subcommand argument structs is irrelevant.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
     Simulate(cmd::simulate::Args),
+    /// Cutting force and runout from two-point shank deflection (capacitive sensors).
+    Shank(cmd::shank::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
+        Command::Shank(a) => cmd::shank::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -17,6 +17,7 @@ mod filter;
 mod process;
 mod spindle;
 mod stiffness;
+mod synthetic;
 mod template;
 
 pub use calibration::{calibrate, LoadStep, StaticCalibration};
@@ -30,6 +31,7 @@ pub use spindle::{
     frequency_from_air, peak_frequency, phasor, PhaseSegment, PulseDetector, SpindlePhase,
 };
 pub use stiffness::{LoadPoint, ShankBeam};
+pub use synthetic::{SyntheticRecording, SyntheticShank};
 pub use template::{AngleTemplate, TemplateBuilder};
 
 /// Errors of the shank method.

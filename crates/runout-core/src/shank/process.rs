@@ -206,7 +206,8 @@ pub struct Survey {
     /// Flat runs per channel: (start, end, value).
     pub flat_runs: Vec<Vec<(u64, u64, f64)>>,
     range: Vec<(f64, f64)>,
-    saturated_by_range: u64,
+    range_open: Vec<Option<u64>>,
+    range_runs: Vec<(u64, u64)>,
 }
 
 /// Samples in a row of identical values from which the run counts as clipped.
@@ -249,7 +250,8 @@ impl Survey {
             flat: vec![(f64::NAN, 0, 0); setup.displacement_channels()],
             flat_runs: vec![Vec::new(); setup.displacement_channels()],
             range: vec![(f64::INFINITY, f64::NEG_INFINITY); setup.displacement_channels()],
-            saturated_by_range: 0,
+            range_open: vec![None; setup.displacement_channels()],
+            range_runs: Vec::new(),
             setup: setup.clone(),
         })
     }
@@ -295,8 +297,14 @@ impl Survey {
                     *f = (v, n, n + 1);
                 }
                 if let Some((lo, hi)) = self.setup.sensor_range_mm {
-                    if v <= lo || v >= hi {
-                        self.saturated_by_range += 1;
+                    let out = v <= lo || v >= hi;
+                    match (out, self.range_open[c]) {
+                        (true, None) => self.range_open[c] = Some(n),
+                        (false, Some(s)) => {
+                            self.range_runs.push((s, n));
+                            self.range_open[c] = None;
+                        }
+                        _ => {}
                     }
                 }
             }
@@ -377,6 +385,9 @@ impl Survey {
             // a clipped run sits at the channel's extreme value
             let (lo, hi) = self.range[c];
             self.flat_runs[c].retain(|r| r.2 == lo || r.2 == hi);
+            if let Some(s) = self.range_open[c] {
+                self.range_runs.push((s, n));
+            }
         }
         let tail_start = n - self.tail[0].len() as u64;
         Ok(SurveyResult {
@@ -389,7 +400,7 @@ impl Survey {
             given: self.given,
             pulse_edges_s: self.pulse.map(|p| p.edges_s),
             flat_runs: self.flat_runs,
-            saturated_by_range: self.saturated_by_range,
+            range_runs: self.range_runs,
             setup: self.setup,
         })
     }
@@ -412,8 +423,8 @@ pub struct SurveyResult {
     pub pulse_edges_s: Option<Vec<f64>>,
     /// Clipped runs per displacement channel (start, end, value).
     pub flat_runs: Vec<Vec<(u64, u64, f64)>>,
-    /// Samples at or beyond the sensor range.
-    pub saturated_by_range: u64,
+    /// Runs of samples at or beyond the sensor range (start, end).
+    pub range_runs: Vec<(u64, u64)>,
     setup: ShankSetup,
 }
 
@@ -827,7 +838,7 @@ pub fn analyse(survey: &SurveyResult) -> Result<ShankAnalysis, ShankError> {
         air_rms.push((ss / cnt.max(1) as f64).sqrt());
     }
     let runout = runout_from_templates(s, &templates);
-    let saturated_samples = sat.iter().map(|r| r.len()).sum::<u64>() + survey.saturated_by_range;
+    let saturated_samples = sat.iter().map(|r| r.len()).sum::<u64>();
     if saturated_samples > 0 {
         warnings.push(format!(
             "{saturated_samples} displacement samples are saturated (clipped at the sensor's range); their force is not computed (NaN) and they are flagged in the output"
@@ -856,6 +867,12 @@ fn saturated_ranges(survey: &SurveyResult) -> Vec<SampleRange> {
         .iter()
         .flatten()
         .map(|&(a, b, _)| SampleRange { start: a, end: b })
+        .chain(
+            survey
+                .range_runs
+                .iter()
+                .map(|&(a, b)| SampleRange { start: a, end: b }),
+        )
         .collect();
     all.sort_by_key(|r| r.start);
     let mut merged: Vec<SampleRange> = Vec::new();

@@ -1,0 +1,459 @@
+//! `runout shank` end to end: stiffness worked examples, force + runout + validation on a
+//! synthetic recording (CSV and DynoWare), binary output, and clear errors for bad inputs.
+
+use assert_cmd::Command;
+use runout_core::shank::{ShankBeam, SyntheticShank};
+use runout_core::*;
+use runout_io::export::{write_dynoware, Channel, TextStyle};
+use std::fs;
+use std::path::{Path, PathBuf};
+
+fn runout() -> Command {
+    let mut c = Command::cargo_bin("runout").unwrap();
+    c.env("RUST_BACKTRACE", "0");
+    c
+}
+
+fn stiffness_json(args: &[&str]) -> serde_json::Value {
+    let out = runout()
+        .args(["shank", "stiffness"])
+        .args(args)
+        .args(["--json", "-"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn stiffness_reproduces_the_patent_examples() {
+    let j = stiffness_json(&[
+        "--modulus-gpa",
+        "210",
+        "--diameter-mm",
+        "8",
+        "--tool-length-mm",
+        "65",
+        "--l1-mm",
+        "10",
+        "--l2-mm",
+        "30",
+    ]);
+    // patent example 1: 1.9488 N/µm (± 0.0001)
+    assert!(
+        (j["stiffness_N_per_um"].as_f64().unwrap() - 1.9488).abs() <= 1e-4,
+        "{j}"
+    );
+    assert_eq!(j["schema"], "runout.shank.stiffness/1");
+    let j = stiffness_json(&[
+        "--modulus-gpa",
+        "610",
+        "--diameter-mm",
+        "12",
+        "--tool-length-mm",
+        "85",
+        "--l1-mm",
+        "15",
+        "--l2-mm",
+        "35",
+    ]);
+    assert!(
+        (j["stiffness_N_per_um"].as_f64().unwrap() - 17.2874).abs() <= 1e-4,
+        "{j}"
+    );
+    // unit suffixes are accepted and converted
+    let j = stiffness_json(&[
+        "--modulus-gpa",
+        "210GPa",
+        "--diameter-mm",
+        "0.8cm",
+        "--tool-length-mm",
+        "65",
+        "--l1-mm",
+        "10mm",
+        "--l2-mm",
+        "30",
+    ]);
+    assert!((j["stiffness_N_per_um"].as_f64().unwrap() - 1.948754).abs() <= 1e-6);
+    // load at mid depth (a_p = 2 mm → a = 64 mm): 1.985 N/µm
+    let j = stiffness_json(&[
+        "--modulus-gpa",
+        "210",
+        "--diameter-mm",
+        "8",
+        "--tool-length-mm",
+        "65",
+        "--l1-mm",
+        "10",
+        "--l2-mm",
+        "30",
+        "--ap-mm",
+        "2",
+    ]);
+    assert!((j["stiffness_N_per_um"].as_f64().unwrap() - 1.985).abs() < 5e-4);
+    // text output
+    runout()
+        .args([
+            "shank",
+            "stiffness",
+            "--modulus-gpa",
+            "210",
+            "--diameter-mm",
+            "8",
+            "--tool-length-mm",
+            "65",
+            "--l1-mm",
+            "10",
+            "--l2-mm",
+            "30",
+        ])
+        .assert()
+        .success()
+        .stdout(predicates::str::contains("K_delta = 1.948754 N/um"));
+}
+
+#[test]
+fn stiffness_rejects_bad_geometry() {
+    let base = [
+        "shank",
+        "stiffness",
+        "--modulus-gpa",
+        "210",
+        "--diameter-mm",
+        "8",
+        "--tool-length-mm",
+        "65",
+    ];
+    let out = runout()
+        .args(base)
+        .args(["--l1-mm", "20", "--l2-mm", "20"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("l2_mm") && err.contains("equal heights"),
+        "{err}"
+    );
+    let out = runout()
+        .args(base)
+        .args(["--l1-mm", "10", "--l2-mm", "70"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("l2_mm") && err.contains("tool_length_mm = 65"),
+        "{err}"
+    );
+    let out = runout()
+        .args(base)
+        .args(["--l1-mm", "10", "--l2-mm", "3rpm"])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--l2-mm"));
+}
+
+/// A synthetic recording: (x_I, x_II, y_I, y_II in µm, F_x, F_y in N), cut range.
+fn synthetic(before: f64, cut: f64, after: f64) -> (Vec<Vec<f64>>, (usize, usize)) {
+    let cutter = Cutter::flat(8.0, 3, 30.0).unwrap();
+    let runout = Runout::new(0.010, 0.5).unwrap();
+    let c = Cut::new(3000.0, 0.05, 2.0)
+        .unwrap()
+        .radial(2.0, MillingMode::Down, &cutter)
+        .unwrap();
+    let coefficients =
+        CuttingCoefficients::new([1889.2, 806.1, 291.0], [63.12, 113.7, -3.1]).unwrap();
+    let chip = ArcChip::new(&cutter, &runout, 0.05).unwrap();
+    let series = ForceModel {
+        cutter,
+        runout,
+        cut: c,
+        coefficients,
+    }
+    .simulate(&chip, &Sampling::new(1.0, 0.5, 10).unwrap());
+    let syn = SyntheticShank {
+        beam: ShankBeam::new(210.0, 8.0, 65.0, 10.0, 30.0).unwrap(),
+        sample_rate_hz: 20_000.0,
+        rpm: 3003.0,
+        revolutions: (before, cut, after),
+        offset_mm: (0.010 * 0.7f64.cos(), 0.010 * 0.7f64.sin()),
+        tilt: (0.0002 * 2.1f64.cos(), 0.0002 * 2.1f64.sin()),
+        form_mm: (0.0015, 0.0005),
+        gap_mm: (0.5, 0.48),
+        drift_mm: 0.0005,
+        ramp_revolutions: 2.0,
+        pulse: false,
+    };
+    let mut k = 0u64;
+    // deterministic pseudo-noise, ±0.05 µm
+    let rec = syn.generate(&series.fx, &series.fy, || {
+        k = k
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((k >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 1e-4
+    });
+    let mut cols: Vec<Vec<f64>> = rec
+        .columns
+        .iter()
+        .map(|c| c.iter().map(|v| v * 1e3).collect())
+        .collect();
+    cols.push(rec.force_n[0].clone());
+    cols.push(rec.force_n[1].clone());
+    (cols, rec.cut)
+}
+
+fn write_csv(path: &Path, cols: &[Vec<f64>]) {
+    let mut s = String::from("time_s,xI_um,xII_um,yI_um,yII_um,Fx_N,Fy_N\n");
+    for k in 0..cols[0].len() {
+        s += &format!("{:.6}", k as f64 / 20_000.0);
+        for c in cols {
+            s += &format!(",{:.4}", c[k]);
+        }
+        s.push('\n');
+    }
+    fs::write(path, s).unwrap();
+}
+
+fn config(dir: &Path, extra: &str) -> PathBuf {
+    let text = fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/shank.toml"
+    ))
+    .unwrap();
+    let p = dir.join("shank.toml");
+    fs::write(&p, text + extra).unwrap();
+    p
+}
+
+fn force_json(rec: &Path, cfg: &Path, extra: &[&str]) -> serde_json::Value {
+    let out = runout()
+        .args(["shank", "force"])
+        .arg(rec)
+        .arg("--config")
+        .arg(cfg)
+        .args(extra)
+        .args(["--json", "-"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn force_runout_and_validation_from_a_csv_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let (cols, cut) = synthetic(15.0, 60.0, 15.0);
+    let rec = dir.path().join("rec.csv");
+    write_csv(&rec, &cols);
+    let cfg = config(dir.path(), "");
+    let out_csv = dir.path().join("force.csv");
+    let plots = dir.path().join("plots");
+    let j = force_json(
+        &rec,
+        &cfg,
+        &[
+            "--out",
+            out_csv.to_str().unwrap(),
+            "--plot-dir",
+            plots.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(j["schema"], "runout.shank.force/1");
+    // validation against the true force: within 2 % RMS, correlation > 0.999
+    for v in j["validation"]["per_axis"].as_array().unwrap() {
+        assert!(v["relative_rms_error"].as_f64().unwrap() < 0.02, "{v}");
+        assert!(v["correlation"].as_f64().unwrap() > 0.999, "{v}");
+    }
+    assert_eq!(j["validation"]["reference_axes"], "x = Fx, y = Fy");
+    // runout at the tip 10 µm and tilt 0.2 µm/mm (noise ±0.05 µm; tolerances 0.1 µm, 0.005 µm/mm)
+    let r = &j["runout"];
+    assert!(
+        (r["tip_offset_um"].as_f64().unwrap() - 10.0).abs() < 0.1,
+        "{r}"
+    );
+    assert!(
+        (r["tilt_um_per_mm"].as_f64().unwrap() - 0.2).abs() < 0.005,
+        "{r}"
+    );
+    // spindle speed 3003 rpm (nominal 3000): within 0.01 rpm
+    assert!(
+        (j["spindle"]["rpm"].as_f64().unwrap() - 3003.0).abs() < 0.01,
+        "{}",
+        j["spindle"]
+    );
+    // the cut found brackets the true one
+    let cs = j["cut_s"].as_array().unwrap();
+    assert!(cs[0].as_f64().unwrap() <= cut.0 as f64 / 20_000.0 + 1e-4);
+    assert!(cs[1].as_f64().unwrap() >= cut.1 as f64 / 20_000.0 - 1e-4);
+    // output: one row per sample, units in the header
+    let text = fs::read_to_string(&out_csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "time_s,fx_N,fy_N,delta_x_I_um,delta_x_II_um,delta_y_I_um,delta_y_II_um,reference_fx_N,reference_fy_N,saturated"
+    );
+    assert_eq!(lines.count(), cols[0].len());
+    for p in ["raw", "template", "deflection", "force", "force_zoom"] {
+        assert!(plots.join(format!("{p}.svg")).exists(), "{p}");
+    }
+    // binary output carries the same numbers (f64)
+    let bin = dir.path().join("force.bin");
+    force_json(
+        &rec,
+        &cfg,
+        &["--out", bin.to_str().unwrap(), "--binary-type", "f64"],
+    );
+    let (header, bcols) = runout_io::recording::read_binary(fs::File::open(&bin).unwrap()).unwrap();
+    assert_eq!(header["columns"][1], "fx_N");
+    assert_eq!(bcols[0].len(), cols[0].len());
+    let row5: Vec<f64> = text
+        .lines()
+        .nth(1001)
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!(bcols[1][1000], row5[1]);
+}
+
+#[test]
+fn dynoware_input_with_decimal_commas_gives_the_same_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let (cols, _) = synthetic(10.0, 30.0, 10.0);
+    let names = ["xI", "xII", "yI", "yII", "Fx", "Fy"];
+    let units = ["um", "um", "um", "um", "N", "N"];
+    let channels: Vec<Channel> = (0..6)
+        .map(|i| Channel {
+            name: names[i],
+            unit: units[i],
+            data: &cols[i],
+        })
+        .collect();
+    let mut buf = Vec::new();
+    write_dynoware(
+        &mut buf,
+        20_000.0,
+        &[("Filename", "shank.dwd")],
+        &channels,
+        TextStyle {
+            delimiter: ';',
+            decimal_comma: true,
+        },
+    )
+    .unwrap();
+    let rec = dir.path().join("rec.txt");
+    fs::write(&rec, buf).unwrap();
+    let j = force_json(&rec, &config(dir.path(), ""), &[]);
+    assert!(j["format"].as_str().unwrap().contains("DynoWare"));
+    for v in j["validation"]["per_axis"].as_array().unwrap() {
+        assert!(v["relative_rms_error"].as_f64().unwrap() < 0.02, "{v}");
+    }
+}
+
+#[test]
+fn bad_inputs_give_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let (cols, _) = synthetic(10.0, 30.0, 10.0);
+    let rec = dir.path().join("rec.csv");
+    write_csv(&rec, &cols);
+    // channel missing
+    let text = fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/shank.toml"
+    ))
+    .unwrap();
+    let cfg = dir.path().join("missing.toml");
+    fs::write(&cfg, text.replace("\"yII\"", "\"zII\"")).unwrap();
+    let out = runout()
+        .args(["shank", "force"])
+        .arg(&rec)
+        .arg("--config")
+        .arg(&cfg)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("rec.csv:1: no column `zII`") && err.contains("yII_um"),
+        "{err}"
+    );
+    // sensors at equal heights in the config
+    let cfg = dir.path().join("equal.toml");
+    fs::write(&cfg, text.replace("l2_mm = 30", "l2_mm = 10")).unwrap();
+    let out = runout()
+        .args(["shank", "force"])
+        .arg(&rec)
+        .arg("--config")
+        .arg(&cfg)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("l2_mm") && err.contains("equal heights"),
+        "{err}"
+    );
+    // unknown key
+    let cfg = dir.path().join("typo.toml");
+    fs::write(&cfg, text.replace("l2_mm", "l22_mm")).unwrap();
+    let out = runout()
+        .args(["shank", "force"])
+        .arg(&rec)
+        .arg("--config")
+        .arg(&cfg)
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("l22_mm"));
+    // no air cut: the cut starts after 2 revolutions and never ends
+    let (cols, _) = synthetic(2.0, 30.0, 0.0);
+    let rec2 = dir.path().join("nocut.csv");
+    write_csv(&rec2, &cols);
+    let out = runout()
+        .args(["shank", "force"])
+        .arg(&rec2)
+        .arg("--config")
+        .arg(config(dir.path(), ""))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no air-cut segment found") && err.contains("nocut.csv"),
+        "{err}"
+    );
+}
+
+#[test]
+fn saturated_samples_are_flagged_in_the_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut cols, cut) = synthetic(10.0, 30.0, 10.0);
+    let mid = (cut.0 + cut.1) / 2;
+    for v in &mut cols[1][mid..mid + 50] {
+        *v = 800.0; // the sensor's rail
+    }
+    let rec = dir.path().join("sat.csv");
+    write_csv(&rec, &cols);
+    let out_csv = dir.path().join("f.csv");
+    let j = force_json(
+        &rec,
+        &config(dir.path(), "sensor_range_um = [0, 800]\n"),
+        &["--out", out_csv.to_str().unwrap()],
+    );
+    assert_eq!(
+        j["saturated_samples"].as_u64().unwrap(),
+        50,
+        "{}",
+        j["saturated_samples"]
+    );
+    assert!(j["warnings"].to_string().contains("saturated"));
+    let text = fs::read_to_string(&out_csv).unwrap();
+    let row: Vec<&str> = text.lines().nth(mid + 1).unwrap().split(',').collect();
+    assert_eq!(row[1], "NaN");
+    assert_eq!(*row.last().unwrap(), "1.0");
+}
