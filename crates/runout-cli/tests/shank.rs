@@ -457,3 +457,44 @@ fn saturated_samples_are_flagged_in_the_output() {
     assert_eq!(row[1], "NaN");
     assert_eq!(*row.last().unwrap(), "1.0");
 }
+
+#[test]
+fn static_calibration_from_a_load_recording() {
+    // load steps at two positions; the true shank has a holder of k_θ = 20 kN·m/rad
+    let beam = ShankBeam::new(210.0, 8.0, 65.0, 10.0, 30.0).unwrap();
+    let held = beam.with_holder_stiffness(2e7).unwrap();
+    let mut s = String::from("load_N,a_mm,xI_um,xII_um\n");
+    let mut k = 0u64;
+    for a in [40.0, 52.0, 64.0] {
+        let at = held.with_load_point(runout_core::shank::LoadPoint::At { distance_mm: a }).unwrap();
+        for f in [0.0, 25.0, 50.0, 75.0, 100.0] {
+            for _ in 0..20 {
+                k = k.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                let noise = ((k >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.02; // ±0.01 µm
+                let d1 = at.compliance_at_mm_per_n(10.0) * f * 1e3 + 3.0;
+                let d2 = at.compliance_at_mm_per_n(30.0) * f * 1e3 + 5.0 + noise;
+                s += &format!("{f},{a},{d1:.5},{d2:.5}\n");
+            }
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("static.csv");
+    fs::write(&rec, s).unwrap();
+    let cfg = config(dir.path(), "");
+    let out = runout()
+        .args(["shank", "calibrate"])
+        .arg(&rec)
+        .arg("--config")
+        .arg(&cfg)
+        .args(["--force-channel", "load_N", "--load-point-channel", "a_mm", "--json", "-"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let truth = held.stiffness_n_per_um();
+    let (k_fit, se) = (j["stiffness_N_per_um"].as_f64().unwrap(), j["stiffness_se_N_per_um"].as_f64().unwrap());
+    assert!((k_fit - truth).abs() < 4.0 * se && se < 0.002 * truth, "{j}");
+    let holder = j["holder_stiffness_Nm_per_rad"].as_f64().unwrap();
+    assert!((holder / 2e4 - 1.0).abs() < 0.05, "{j}");
+    assert_eq!(j["steps"], 300);
+}

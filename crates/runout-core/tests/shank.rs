@@ -486,3 +486,52 @@ proptest! {
         prop_assert!(((f - f_true) * TAU * gap).abs() < 1e-3, "{} vs {}", f, f_true);
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(8))]
+
+    /// Round trip over realistic ranges: runout 2–20 µm at any angle, tilt up to 0.5 µm/mm,
+    /// spindle-speed error up to ±0.5 %, sensor sign conventions of either kind.
+    #[test]
+    fn round_trip_over_realistic_ranges(
+        rho_um in 2.0f64..20.0, lam in 0.0f64..TAU, tilt_um in 0.0f64..0.5, tilt_dir in 0.0f64..TAU,
+        speed_err in -0.005f64..0.005, sign_x in prop_oneof![Just(1.0), Just(-1.0)], seed in 0u64..1000,
+    ) {
+        let beam = example1();
+        let syn = SyntheticShank {
+            beam,
+            sample_rate_hz: FS,
+            rpm: RPM * (1.0 + speed_err),
+            revolutions: (8.0, 40.0, 8.0),
+            offset_mm: (rho_um * 1e-3 * lam.cos(), rho_um * 1e-3 * lam.sin()),
+            tilt: (tilt_um * 1e-3 * tilt_dir.cos(), tilt_um * 1e-3 * tilt_dir.sin()),
+            form_mm: (0.001, 0.0005),
+            gap_mm: (0.5, 0.45),
+            drift_mm: 0.0003,
+            ramp_revolutions: 1.0,
+            pulse: false,
+        };
+        // a simple 3-tooth force pattern per revolution
+        let n = 720;
+        let fx: Vec<f64> = (0..n).map(|i| 60.0 * ((3.0 * TAU * i as f64 / n as f64).sin()).max(0.0)).collect();
+        let fy: Vec<f64> = (0..n).map(|i| -150.0 * ((3.0 * TAU * i as f64 / n as f64 + 0.4).sin()).max(0.0)).collect();
+        let mut rng = StdRng::seed_from_u64(seed);
+        let noise = Normal::new(0.0, 5e-5).unwrap();
+        let mut rec = syn.generate(&fx, &fy, || rng.sample(noise));
+        // a sensor pair mounted the other way round reads the negated displacement
+        for c in &mut rec.columns[..2] {
+            c.iter_mut().for_each(|v| *v *= sign_x);
+        }
+        let mut s = setup(false);
+        s.pairs[0].sign = sign_x;
+        let cols: Vec<&[f64]> = rec.columns.iter().map(Vec::as_slice).collect();
+        let (an, out, _) = process_in_memory(&s, &cols).unwrap();
+        let ex = rms_error(&out.force_n[0], &rec.force_n[0], rec.cut);
+        let ey = rms_error(&out.force_n[1], &rec.force_n[1], rec.cut);
+        prop_assert!(ex < 0.02 && ey < 0.02, "errors {} {}", ex, ey);
+        // offset within 0.1 µm and tilt within 0.005 µm/mm (16 air revolutions, 0.05 µm noise)
+        let r = &an.runout;
+        prop_assert!((r.tip_offset_mm.0 - syn.offset_mm.0).hypot(r.tip_offset_mm.1 - syn.offset_mm.1) < 1e-4, "{:?} vs {:?}", r.tip_offset_mm, syn.offset_mm);
+        prop_assert!((r.tilt.0 - syn.tilt.0).hypot(r.tilt.1 - syn.tilt.1) < 5e-6, "{:?} vs {:?}", r.tilt, syn.tilt);
+    }
+}
