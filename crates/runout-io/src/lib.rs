@@ -8,4 +8,5 @@
 pub mod config;
 pub mod export;
 pub mod plot;
+pub mod recording;
 pub mod units;
