@@ -136,7 +136,17 @@ const GOOD: &str = "teeth = 4\ndiameter_mm = 10\nrpm = 3000\nfz_mm = 0.1\nap_mm 
 #[test]
 fn bad_configs_name_the_key_and_what_was_expected() {
     assert!(with_config(GOOD).0);
-    let cases: [(&str, &str, &str); 9] = [
+    let cases: [(&str, &str, &str); 11] = [
+        (
+            "ap_mm = 1",
+            "ap_mm = 1\nflute_length_mm = 0.5",
+            "flute length",
+        ),
+        (
+            "revolutions = 1",
+            "revolutions = 1e9",
+            "at most 100000000 samples",
+        ),
         ("diameter_mm = 10", "diameter_mm = -10", "diameter_mm"),
         ("diameter_mm = 10", "diameter_mm = 0", "diameter_mm"),
         ("ae_mm = 2", "ae_mm = 12", "ae_mm"),

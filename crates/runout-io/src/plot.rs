@@ -1,6 +1,8 @@
 //! Plots (SVG and PNG by file extension) with plotters. PNG text is rasterised from an embedded
 //! DejaVu Sans font (Bitstream Vera licence), so no system fonts are needed.
 
+pub mod identify;
+
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use runout_core::{ForceSeries, ToothPeak};

@@ -209,6 +209,16 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
     let fz = s.require("fz_mm", Quantity::LengthMm, "feed per tooth")?;
     let ap = s.require("ap_mm", Quantity::LengthMm, "axial depth of cut")?;
     let base = Cut::new(rpm, fz, ap).map_err(|e| key_err(s, e))?;
+    if ap > cutter.flute_length() {
+        return Err(ConfigError::Key {
+            source_name: s.origin("ap_mm").unwrap_or("config").into(),
+            key: "ap_mm".into(),
+            message: format!(
+                "expected an axial depth within the flute length {} mm, got {ap}",
+                cutter.flute_length()
+            ),
+        });
+    }
     let cut = if s.has("entry_deg") || s.has("exit_deg") {
         let en = s.require("entry_deg", Quantity::AngleDeg, "entry angle")?;
         let ex = s.require("exit_deg", Quantity::AngleDeg, "exit angle")?;
