@@ -24,7 +24,9 @@ fn generate() -> Vec<u8> {
             0.0
         }
     };
-    let fx: Vec<f64> = (0..per_rev).map(|i| pulse(i, 80.0) * (TAU * i as f64 / per_rev as f64).cos()).collect();
+    let fx: Vec<f64> = (0..per_rev)
+        .map(|i| pulse(i, 80.0) * (TAU * i as f64 / per_rev as f64).cos())
+        .collect();
     let fy: Vec<f64> = (0..per_rev).map(|i| -pulse(i, 200.0)).collect();
     let syn = SyntheticShank {
         beam: ShankBeam::new(210.0, 8.0, 65.0, 10.0, 30.0).unwrap(),
@@ -41,7 +43,9 @@ fn generate() -> Vec<u8> {
     };
     let mut k = 1u64;
     let rec = syn.generate(&fx, &fy, || {
-        k = k.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        k = k
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((k >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 1e-4
     });
     let mut s = String::from("time_s,xI_um,xII_um,yI_um,yII_um\n");
@@ -62,8 +66,14 @@ fn setup() -> ShankSetup {
     ShankSetup::new(
         ShankBeam::new(210.0, 8.0, 65.0, 10.0, 30.0).unwrap(),
         vec![
-            SensorPair { axis: PairAxis::X, sign: 1.0 },
-            SensorPair { axis: PairAxis::Y, sign: 1.0 },
+            SensorPair {
+                axis: PairAxis::X,
+                sign: 1.0,
+            },
+            SensorPair {
+                axis: PairAxis::Y,
+                sign: 1.0,
+            },
         ],
         FS,
         6000.0,
@@ -71,7 +81,9 @@ fn setup() -> ShankSetup {
 }
 
 fn to_mm(c: &mut Chunk) {
-    c.values.iter_mut().for_each(|v| v.iter_mut().for_each(|x| *x *= 1e-3));
+    c.values
+        .iter_mut()
+        .for_each(|v| v.iter_mut().for_each(|x| *x *= 1e-3));
 }
 
 fn pipeline(bytes: &[u8]) -> f64 {
@@ -129,7 +141,9 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("shank_4ch_100kHz_csv");
     g.throughput(Throughput::Bytes(bytes.len() as u64));
     g.sample_size(10);
-    g.bench_function("parse_only_one_pass", |b| b.iter(|| black_box(parse_only(black_box(&bytes)))));
+    g.bench_function("parse_only_one_pass", |b| {
+        b.iter(|| black_box(parse_only(black_box(&bytes))))
+    });
     g.bench_function("force_pipeline_two_passes_with_csv_output", |b| {
         b.iter(|| black_box(pipeline(black_box(&bytes))))
     });

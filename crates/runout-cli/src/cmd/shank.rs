@@ -85,6 +85,10 @@ pub struct ForceArgs {
     /// runout.binary/1, see --binary-type); `-` = CSV to stdout.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Parse the text recording again in pass 2 instead of keeping a temporary binary copy of
+    /// the channels (in the temp directory, ≈ 8 bytes per channel and sample, deleted at the end).
+    #[arg(long)]
+    reparse: bool,
     /// Element type of a `.bin` output: f32 or f64.
     #[arg(long, default_value = "f32")]
     binary_type: String,
@@ -574,8 +578,16 @@ fn force(a: ForceArgs) -> Result<()> {
     let mut reader = open(&a.recording, &r, &plan.names)?;
     let mut chunk = Chunk::default();
     let mut raw = Thinned::new();
+    let mut spill = if a.reparse {
+        None
+    } else {
+        Some(Spill::create(plan.names.len())?)
+    };
     while reader.read_chunk(&mut chunk, 65_536)? > 0 {
         scale_chunk(&mut chunk, &plan.scales);
+        if let Some(sp) = spill.as_mut() {
+            sp.write(&chunk)?;
+        }
         let cols: Vec<&[f64]> = chunk.values.iter().map(Vec::as_slice).collect();
         survey.push(&cols[..nkeep])?;
         for k in 0..chunk.len() {
@@ -607,10 +619,29 @@ fn force(a: ForceArgs) -> Result<()> {
                 json!({"sample_rate_hz": info.sample_rate_hz, "source": info.file, "saturated": "1 = sensor saturated, force NaN"}),
             )?))
         }
-        Some(p) => Some(Sink::Csv(CsvWriter::new(output::create(p)?, &columns)?)),
+        Some(p) => {
+            // fixed decimals: time to 1/(100 f_s), forces 0.1 mN, deflections 0.01 nm
+            let dt_dec = (info.sample_rate_hz.log10().ceil() as u32 + 2).min(12);
+            let decimals: Vec<u32> = columns
+                .iter()
+                .map(|c| match c.as_str() {
+                    "time_s" => dt_dec,
+                    "saturated" => 0,
+                    c if c.ends_with("_um") => 5,
+                    _ => 4,
+                })
+                .collect();
+            Some(Sink::Csv(
+                CsvWriter::new(output::create(p)?, &columns)?.with_decimals(&decimals)?,
+            ))
+        }
     };
     let bar = progress(info.file_bytes, "pass 2/2");
-    let mut reader = open(&a.recording, &r, &plan.names)?;
+    let mut warnings: Vec<String> = reader.warnings().to_vec();
+    let mut source = match spill.as_mut() {
+        Some(sp) => Pass2::Spill(sp.reader()?),
+        None => Pass2::Text(Box::new(open(&a.recording, &r, &plan.names)?)),
+    };
     let mut out = OutputBlock::default();
     let mut series = Thinned::new();
     let mut stats = vec![Stats::default(); r.setup.pairs.len()];
@@ -659,13 +690,28 @@ fn force(a: ForceArgs) -> Result<()> {
         }
         Ok(())
     };
-    while reader.read_chunk(&mut chunk, 65_536)? > 0 {
-        scale_chunk(&mut chunk, &plan.scales);
+    loop {
+        let n = match &mut source {
+            Pass2::Text(rd) => {
+                let n = rd.read_chunk(&mut chunk, 65_536)?;
+                scale_chunk(&mut chunk, &plan.scales);
+                bar.set_position(rd.bytes_read());
+                n
+            }
+            Pass2::Spill(sr) => {
+                let n = sr.read_chunk(&mut chunk)?;
+                bar.inc(n as u64 * info.file_bytes.unwrap_or(0) / samples.max(1));
+                n
+            }
+        };
+        if n == 0 {
+            break;
+        }
         let cols: Vec<&[f64]> = chunk.values.iter().map(Vec::as_slice).collect();
         rec.push(&cols, &mut out);
         consume(&out, &mut sink)?;
-        bar.set_position(reader.bytes_read());
     }
+    drop(spill);
     rec.finish(&mut out);
     consume(&out, &mut sink)?;
     bar.finish_and_clear();
@@ -673,7 +719,6 @@ fn force(a: ForceArgs) -> Result<()> {
         s.finish().context("writing the output")?;
     }
     let comparison = rec.comparison();
-    let mut warnings: Vec<String> = reader.warnings().to_vec();
     warnings.extend(analysis.warnings.iter().cloned());
     let summary = summary_json(
         &a,
@@ -701,6 +746,116 @@ fn force(a: ForceArgs) -> Result<()> {
         print_summary(&summary);
     }
     Ok(())
+}
+
+/// Where pass 2 reads from.
+enum Pass2 {
+    Text(Box<RecordingReader<std::io::BufReader<std::fs::File>>>),
+    Spill(SpillReader),
+}
+
+/// A temporary binary copy of the converted channels (per chunk: u64 LE row count, then each
+/// channel's values as f64 LE), deleted when dropped.
+struct Spill {
+    path: PathBuf,
+    writer: Option<std::io::BufWriter<std::fs::File>>,
+    channels: usize,
+}
+
+impl Spill {
+    fn create(channels: usize) -> Result<Self> {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        let path =
+            std::env::temp_dir().join(format!("runout-shank-{}-{nanos}.tmp", std::process::id()));
+        let f = std::fs::File::create(&path).with_context(|| {
+            format!(
+                "creating the temporary file {} (or use --reparse)",
+                path.display()
+            )
+        })?;
+        Ok(Self {
+            path,
+            writer: Some(std::io::BufWriter::with_capacity(1 << 20, f)),
+            channels,
+        })
+    }
+
+    fn write(&mut self, chunk: &Chunk) -> Result<()> {
+        use std::io::Write;
+        let w = self.writer.as_mut().expect("writer open during pass 1");
+        let mut bytes = Vec::with_capacity(8 + 8 * chunk.len() * self.channels);
+        bytes.extend_from_slice(&(chunk.len() as u64).to_le_bytes());
+        for c in &chunk.values {
+            for v in c {
+                bytes.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        w.write_all(&bytes)
+            .with_context(|| format!("writing {} (or use --reparse)", self.path.display()))
+    }
+
+    fn reader(&mut self) -> Result<SpillReader> {
+        use std::io::Write;
+        if let Some(mut w) = self.writer.take() {
+            w.flush()
+                .with_context(|| format!("writing {}", self.path.display()))?;
+        }
+        let f = std::fs::File::open(&self.path)
+            .with_context(|| format!("reading {}", self.path.display()))?;
+        Ok(SpillReader {
+            r: std::io::BufReader::with_capacity(1 << 20, f),
+            channels: self.channels,
+            first: 0,
+            bytes: Vec::new(),
+        })
+    }
+}
+
+impl Drop for Spill {
+    fn drop(&mut self) {
+        self.writer = None;
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// Reads the spill file chunk by chunk.
+struct SpillReader {
+    r: std::io::BufReader<std::fs::File>,
+    channels: usize,
+    first: u64,
+    bytes: Vec<u8>,
+}
+
+impl SpillReader {
+    fn read_chunk(&mut self, chunk: &mut Chunk) -> Result<usize> {
+        use std::io::Read;
+        let mut head = [0u8; 8];
+        match self.r.read_exact(&mut head) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => return Ok(0),
+            Err(e) => return Err(e).context("reading the temporary file"),
+        }
+        let n = u64::from_le_bytes(head) as usize;
+        chunk.first_sample = self.first;
+        chunk.time_s.clear();
+        chunk.values.resize_with(self.channels, Vec::new);
+        self.bytes.resize(8 * n, 0);
+        for c in &mut chunk.values {
+            self.r
+                .read_exact(&mut self.bytes)
+                .context("reading the temporary file")?;
+            c.clear();
+            c.extend(
+                self.bytes
+                    .chunks_exact(8)
+                    .map(|b| f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]])),
+            );
+        }
+        self.first += n as u64;
+        Ok(n)
+    }
 }
 
 fn scale_chunk(chunk: &mut Chunk, scales: &[f64]) {
