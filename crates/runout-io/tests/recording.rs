@@ -404,6 +404,22 @@ proptest! {
         let _ = Recording::from_bytes("fuzz", &bytes, &ReadOptions::new());
     }
 
+    /// Fixed-decimal CSV output reads back within half a unit of the last decimal.
+    #[test]
+    fn fixed_decimal_output_reads_back(v in -1e9f64..1e9, d in 0u32..9) {
+        let mut w = runout_io::recording::CsvWriter::new(Vec::new(), &["v"]).unwrap().with_decimals(&[d]).unwrap();
+        w.write_row(&[v]).unwrap();
+        let text = String::from_utf8(w.finish().unwrap()).unwrap();
+        let cell = text.lines().nth(1).unwrap();
+        let back: f64 = cell.parse().unwrap();
+        prop_assert!((back - v).abs() <= 0.5 * 10f64.powi(-(d as i32)) * (1.0 + 1e-9) + v.abs() * 1e-15, "{} → {}", v, cell);
+        // beyond 9e15 units of the last decimal the writer falls back to round-trip text
+        if v.abs() * 10f64.powi(d as i32) < 9e15 {
+            let decimals = cell.split('.').nth(1).map_or(0, str::len);
+            prop_assert_eq!(decimals as u32, d);
+        }
+    }
+
     /// Numbers written by Rust (plain, exponent, decimal comma) read back exactly.
     #[test]
     fn numbers_round_trip_exactly(v in -1e6f64..1e6, e in -30i32..30, comma in any::<bool>()) {
