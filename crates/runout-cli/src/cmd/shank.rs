@@ -991,7 +991,7 @@ fn print_summary(j: &serde_json::Value) {
         j["stiffness_source"].as_str().unwrap_or("")
     );
     println!(
-        "spindle          {:.3} rpm ± {:.4} ({})",
+        "spindle          {:.4} rpm ± {:.1e} ({})",
         j["spindle"]["rpm"].as_f64().unwrap_or(f64::NAN),
         j["spindle"]["rpm_se"].as_f64().unwrap_or(f64::NAN),
         j["spindle"]["source"].as_str().unwrap_or("")

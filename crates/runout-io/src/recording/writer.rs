@@ -40,12 +40,13 @@ const PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
 /// exactly in the integer range (the caller falls back to the shortest round-trip form).
 /// Digits are produced two at a time from a table (this is the CSV output's hot loop).
 fn fixed(v: f64, d: u32, out: &mut Vec<u8>) -> Option<()> {
-    let scaled = (v * TEN[d as usize]).round();
+    let scaled = v * TEN[d as usize];
     if scaled.is_nan() || scaled.abs() >= 9.0e15 {
         return None;
     }
-    let mut i = scaled.abs() as u64;
-    if scaled < 0.0 {
+    // round half away from zero with a truncating conversion (f64::round is a libm call)
+    let mut i = (scaled.abs() + 0.5) as u64;
+    if scaled < 0.0 && i != 0 {
         out.push(b'-');
     }
     // digits into a right-aligned buffer, at least d + 1 of them
