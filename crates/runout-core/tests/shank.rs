@@ -535,3 +535,20 @@ proptest! {
         prop_assert!((r.tilt.0 - syn.tilt.0).hypot(r.tilt.1 - syn.tilt.1) < 5e-6, "{:?} vs {:?}", r.tilt, syn.tilt);
     }
 }
+
+#[test]
+fn missing_channels_are_an_error_not_a_panic() {
+    let syn = synthetic(8.0, 10.0, 8.0, false, 2);
+    let cols: Vec<&[f64]> = syn.columns.iter().map(Vec::as_slice).collect();
+    let err = process_in_memory(&setup(false), &cols[..3]).unwrap_err();
+    assert!(matches!(err, ShankError::Input(_)), "{err}");
+    let mut survey = Survey::new(&setup(false)).unwrap();
+    survey.push(&cols).unwrap();
+    let res = survey.finish().unwrap();
+    let an = analyse(&res).unwrap();
+    let mut rec = Reconstructor::new(&res, &an).unwrap();
+    let mut out = OutputBlock::default();
+    assert!(rec.push(&cols[..2], &mut out).is_err());
+    assert!(rec.push(&cols, &mut out).is_ok());
+    assert_eq!(out.len(), cols[0].len());
+}

@@ -112,7 +112,7 @@ fn pipeline(bytes: &[u8]) -> f64 {
     while r.read_chunk(&mut c, 65_536).unwrap() > 0 {
         to_mm(&mut c);
         let cols: Vec<&[f64]> = c.values.iter().map(Vec::as_slice).collect();
-        rec.push(&cols, &mut out);
+        rec.push(&cols, &mut out).unwrap();
         for i in 0..out.len() {
             row = [
                 out.time_s[i],

@@ -708,7 +708,7 @@ fn force(a: ForceArgs) -> Result<()> {
             break;
         }
         let cols: Vec<&[f64]> = chunk.values.iter().map(Vec::as_slice).collect();
-        rec.push(&cols, &mut out);
+        rec.push(&cols, &mut out)?;
         consume(&out, &mut sink)?;
     }
     drop(spill);

@@ -1128,11 +1128,19 @@ impl Reconstructor {
     }
 
     /// Feed a chunk (columns in the input order); rows ready are written to `out` (cleared
-    /// first; with a low-pass they lag by the filter margin).
-    pub fn push(&mut self, columns: &[&[f64]], out: &mut OutputBlock) {
+    /// first; with a low-pass they lag by the filter margin). Errors if the chunk has fewer
+    /// columns than the setup needs or columns of unequal length.
+    pub fn push(&mut self, columns: &[&[f64]], out: &mut OutputBlock) -> Result<(), ShankError> {
         let np = self.setup.pairs.len();
         out.clear(np, self.setup.has_reference);
         let len = columns.first().map_or(0, |c| c.len());
+        if columns.len() < self.setup.input_channels() || columns.iter().any(|c| c.len() != len) {
+            return Err(ShankError::Input(format!(
+                "{} columns per chunk, expected {} of equal length",
+                columns.len(),
+                self.setup.input_channels()
+            )));
+        }
         let dt = 1.0 / self.setup.sample_rate_hz;
         let k_delta = self.analysis.stiffness_n_per_mm;
         let nd = self.setup.displacement_channels();
@@ -1172,6 +1180,7 @@ impl Reconstructor {
                 None => self.emit(n, sat, &row, &refs, out),
             }
         }
+        Ok(())
     }
 
     /// Flush at the end of the record (only needed with a low-pass).
@@ -1246,7 +1255,7 @@ pub fn process_in_memory(
     let mut rec = Reconstructor::new(&result, &analysis)?;
     let mut all = OutputBlock::default();
     let mut part = OutputBlock::default();
-    rec.push(columns, &mut part);
+    rec.push(columns, &mut part)?;
     append(&mut all, &part);
     rec.finish(&mut part);
     append(&mut all, &part);
