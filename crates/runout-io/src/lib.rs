@@ -6,5 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod config;
+pub mod displacement;
+pub mod displacement_plot;
 pub mod plot;
 pub mod units;
