@@ -8,5 +8,7 @@
 pub mod config;
 pub mod displacement;
 pub mod displacement_plot;
+pub mod export;
 pub mod plot;
+pub mod recording;
 pub mod units;
