@@ -23,12 +23,16 @@ struct Cli {
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
     Simulate(cmd::simulate::Args),
+    /// Runout identified in position from displacement readings: per-tooth readings, runout at
+    /// several heights, or a raw signal (methods.md §1).
+    Displacement(cmd::displacement::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
+        Command::Displacement(a) => cmd::displacement::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -42,7 +42,7 @@ fn draw_teeth<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &TeethPlot) 
         .fold(d.offset_um, |m, v| m.max(v.abs()))
         .max(1e-3);
     let base = 3.0 * dev_max;
-    let lim = (base + 1.3 * dev_max) * 1.1;
+    let lim = (base + 1.3 * dev_max) * 1.35;
     let mut chart = ChartBuilder::on(root)
         .caption(&d.title, ("sans-serif", 20))
         .margin(12)
