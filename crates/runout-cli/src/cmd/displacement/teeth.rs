@@ -40,10 +40,7 @@ pub fn run(a: Args) -> Result<()> {
         .cutter()?
         .context("--teeth and --diameter-mm are required")?;
     let k = cutter.teeth();
-    let table = read_tooth_table(&a.readings, k)?;
     let sign = sensor_sign(&a.beam.sensor)?;
-    let readings = ToothReadings::new(k, &table.readings, sign)
-        .with_context(|| format!("{}", a.readings.display()))?;
     let method = match a.method.as_deref() {
         None | Some("joint") => ToothMethod::Joint,
         Some("scan") => ToothMethod::SeedScan,
@@ -57,6 +54,9 @@ pub fn run(a: Args) -> Result<()> {
     opts.noise_mm = um_as_mm("noise-um", &a.noise_um)?;
     opts.beam = a.beam.beam()?;
     opts.phase_hint_rad = quantity("phase-deg", &a.phase_deg, Quantity::AngleDeg)?.map(f64::to_radians);
+    let table = read_tooth_table(&a.readings, k)?;
+    let readings = ToothReadings::new(k, &table.readings, sign)
+        .with_context(|| format!("{}", a.readings.display()))?;
     let fit = identify_from_teeth(&readings, &opts).with_context(|| format!("{}", a.readings.display()))?;
     let cons = match fit.runout() {
         Some(r) => Some(a.cutter.consequences(&cutter, &r)?),
