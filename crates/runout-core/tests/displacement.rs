@@ -38,13 +38,22 @@ fn section7_radius_vectors() {
     let cases: [(usize, f64, &[f64]); 3] = [
         (2, 60.0, &[0.252537126, 0.247537876]),
         (3, 40.0, &[0.253850568, 0.250916561, 0.245307498]),
-        (4, -120.0, &[0.247537876, 0.245682593, 0.252537126, 0.254342414]),
+        (
+            4,
+            -120.0,
+            &[0.247537876, 0.245682593, 0.252537126, 0.254342414],
+        ),
     ];
     for (k, theta, expected) in cases {
         let r = radii(&micro(k), 0.005, theta);
         for (edge, want) in expected.iter().enumerate() {
             let tooth = tooth_from_seed000_edge(edge + 1, k).unwrap();
-            assert!((r[tooth] - want).abs() < 1e-9, "K={k} edge {} got {}", edge + 1, r[tooth]);
+            assert!(
+                (r[tooth] - want).abs() < 1e-9,
+                "K={k} edge {} got {}",
+                edge + 1,
+                r[tooth]
+            );
         }
     }
     let r = radii(&micro(2), 0.005, 60.0);
@@ -63,7 +72,11 @@ fn section7_two_tooth_inversion() {
     match fit.angle {
         AngleEstimate::Ambiguous { candidates_rad, .. } => {
             for c in candidates_rad {
-                assert!((c.to_degrees().abs() - 60.0).abs() < 1e-4, "{}", c.to_degrees());
+                assert!(
+                    (c.to_degrees().abs() - 60.0).abs() < 1e-4,
+                    "{}",
+                    c.to_degrees()
+                );
             }
             assert!(candidates_rad[0] * candidates_rad[1] < 0.0);
         }
@@ -103,13 +116,19 @@ fn round_trip_exact() {
             let fit = identify_from_teeth(&readings(&p), &opts(micro(k))).unwrap();
             assert!((fit.offset_mm - 0.004).abs() < 1e-9);
             let l = fit.angle.angle().unwrap().to_degrees();
-            assert!(runout_core::angle::wrap_deg180(l - lambda).abs() < 1e-6, "K={k} {lambda} {l}");
+            assert!(
+                runout_core::angle::wrap_deg180(l - lambda).abs() < 1e-6,
+                "K={k} {lambda} {l}"
+            );
             let mut o = opts(micro(k));
             o.known_offset_mm = Some(0.004);
             o.method = ToothMethod::SeedScan;
             let scan = identify_from_teeth(&readings(&p), &o).unwrap();
             let l = scan.angle.angle().unwrap().to_degrees();
-            assert!(runout_core::angle::wrap_deg180(l - lambda).abs() < 1e-4, "scan K={k} {lambda} {l}");
+            assert!(
+                runout_core::angle::wrap_deg180(l - lambda).abs() < 1e-4,
+                "scan K={k} {lambda} {l}"
+            );
         }
     }
 }
@@ -141,7 +160,9 @@ fn repeats_estimate_noise() {
     let p = radii(&c, 0.005, 10.0);
     let mut rng = StdRng::seed_from_u64(7);
     let noise = Normal::new(0.0, 1e-4).unwrap();
-    let pairs: Vec<(usize, f64)> = (0..300).map(|j| (j % 3, p[j % 3] + noise.sample(&mut rng))).collect();
+    let pairs: Vec<(usize, f64)> = (0..300)
+        .map(|j| (j % 3, p[j % 3] + noise.sample(&mut rng)))
+        .collect();
     let r = ToothReadings::new(3, &pairs, SensorSign::Radial).unwrap();
     let fit = identify_from_teeth(&r, &opts(c)).unwrap();
     assert_eq!(fit.noise_source, NoiseSource::Repeats);
@@ -178,7 +199,11 @@ fn monte_carlo_joint(k: usize, rho: f64, sigma: f64, trials: usize, seed: u64) -
         lambdas.push(runout_core::angle::wrap_deg180(l.to_degrees() - 40.0));
         ses.push(fit.angle.se().unwrap().to_degrees());
     }
-    (sd(&rhos), sd(&lambdas), ses.iter().sum::<f64>() / trials as f64)
+    (
+        sd(&rhos),
+        sd(&lambdas),
+        ses.iter().sum::<f64>() / trials as f64,
+    )
 }
 
 /// methods.md §1.5 Monte-Carlo, K = 3, r = 5 µm, σ_P = 0.1 µm: table "r ± 0.08 µm, θ sd 1.0°";
@@ -189,7 +214,10 @@ fn monte_carlo_joint(k: usize, rho: f64, sigma: f64, trials: usize, seed: u64) -
 #[test]
 fn monte_carlo_k3_matches_section_1_5() {
     let (sr, sl, se) = monte_carlo_joint(3, 0.005, 1e-4, 3000, 11);
-    let (fr, fl) = (0.1 * (2.0f64 / 3.0).sqrt(), (0.1 * (2.0f64 / 3.0).sqrt() / 5.0).to_degrees());
+    let (fr, fl) = (
+        0.1 * (2.0f64 / 3.0).sqrt(),
+        (0.1 * (2.0f64 / 3.0).sqrt() / 5.0).to_degrees(),
+    );
     eprintln!("K=3 MC: sd r {sr:.4} µm (formula {fr:.4}), sd θ {sl:.3}° (formula {fl:.3}°), reported σ_θ {se:.3}°");
     assert!((sr / fr - 1.0).abs() < 0.052, "sd r {sr} vs {fr}");
     assert!((sl / fl - 1.0).abs() < 0.052, "sd θ {sl} vs {fl}");
@@ -203,7 +231,10 @@ fn monte_carlo_k3_matches_section_1_5() {
 #[test]
 fn monte_carlo_k4_noisy() {
     let (sr, sl, _) = monte_carlo_joint(4, 0.002, 3e-4, 3000, 12);
-    let (fr, fl) = (0.3 * 0.5f64.sqrt(), (0.3 * 0.5f64.sqrt() / 2.0).to_degrees());
+    let (fr, fl) = (
+        0.3 * 0.5f64.sqrt(),
+        (0.3 * 0.5f64.sqrt() / 2.0).to_degrees(),
+    );
     eprintln!("K=4 MC: sd r {sr:.4} µm (formula {fr:.4}), sd θ {sl:.3}° (formula {fl:.3}°)");
     assert!((sr / fr - 1.0).abs() < 0.052, "sd r {sr} vs {fr}");
     assert!((sl / fl - 1.0).abs() < 0.08, "sd θ {sl} vs {fl}");
@@ -224,7 +255,12 @@ fn monte_carlo_k2_known_offset() {
         o.known_offset_mm = Some(0.005);
         o.noise_mm = Some(1e-4);
         let fit = identify_from_teeth(&readings(&p), &o).unwrap();
-        let AngleEstimate::Ambiguous { candidates_rad, se_rad, .. } = fit.angle else {
+        let AngleEstimate::Ambiguous {
+            candidates_rad,
+            se_rad,
+            ..
+        } = fit.angle
+        else {
             panic!("expected ambiguity")
         };
         abs_theta.push(candidates_rad[0].to_degrees().abs());
@@ -232,7 +268,11 @@ fn monte_carlo_k2_known_offset() {
     }
     let f = (1e-4 / (2f64.sqrt() * 0.005)).to_degrees();
     eprintln!("K=2 MC: sd |θ| {:.3}° (formula {f:.3}°)", sd(&abs_theta));
-    assert!((sd(&abs_theta) / f - 1.0).abs() < 0.052, "{} vs {f}", sd(&abs_theta));
+    assert!(
+        (sd(&abs_theta) / f - 1.0).abs() < 0.052,
+        "{} vs {f}",
+        sd(&abs_theta)
+    );
 }
 
 // ---------------------------------------------------------------- §1.3 OLS vs eq. (6)
@@ -248,7 +288,12 @@ fn mc_heights(slope_um_mm: f64, sigma_um: f64, trials: usize, seed: u64) -> (Vec
                 (z, (3.0 + slope_um_mm * z) * 1e-3 + noise.sample(&mut rng))
             })
             .collect();
-        ols.push(runout_at_height(&pts, 0.0, HeightRegression::Ols).unwrap().offset_mm * 1e3);
+        ols.push(
+            runout_at_height(&pts, 0.0, HeightRegression::Ols)
+                .unwrap()
+                .offset_mm
+                * 1e3,
+        );
         if let Ok(f) = runout_at_height(&pts, 0.0, HeightRegression::SeedEq6) {
             eq6.push(f.offset_mm * 1e3);
         }
@@ -271,13 +316,23 @@ fn ols_unbiased_where_eq6_is_biased() {
     let (ols, _) = mc_heights(0.4, 0.1, 4000, 21);
     let m = ols.iter().sum::<f64>() / ols.len() as f64;
     let theory = 0.1 * (0.2f64 + 0.9).sqrt();
-    assert!((m - 3.0).abs() < 4.0 * theory / 4000f64.sqrt(), "OLS mean {m}");
-    assert!((sd(&ols) / theory - 1.0).abs() < 0.05, "OLS sd {}", sd(&ols));
+    assert!(
+        (m - 3.0).abs() < 4.0 * theory / 4000f64.sqrt(),
+        "OLS mean {m}"
+    );
+    assert!(
+        (sd(&ols) / theory - 1.0).abs() < 0.05,
+        "OLS sd {}",
+        sd(&ols)
+    );
 
     let (ols, eq6) = mc_heights(0.1, 0.2, 4000, 22);
     let m = ols.iter().sum::<f64>() / ols.len() as f64;
     let theory = 0.2 * (0.2f64 + 0.9).sqrt();
-    assert!((m - 3.0).abs() < 4.0 * theory / 4000f64.sqrt(), "OLS mean {m}");
+    assert!(
+        (m - 3.0).abs() < 4.0 * theory / 4000f64.sqrt(),
+        "OLS mean {m}"
+    );
     let med = median(eq6);
     eprintln!("heights MC (slope 0.1, σ 0.2): OLS mean {m:.4} µm, eq. (6) median {med:.4} µm");
     assert!((2.54..2.74).contains(&med), "eq. (6) median {med}");
@@ -323,12 +378,18 @@ fn simulate(n: usize, fs: f64, rpm: f64, rho: f64, lambda: f64, sigma: f64, seed
     let w = rpm / 60.0 * TAU;
     let mut rng = StdRng::seed_from_u64(seed);
     let noise = Normal::new(0.0, sigma).unwrap();
-    let mut s = Sim { a: vec![], b: vec![], pulse: vec![], encoder: vec![] };
+    let mut s = Sim {
+        a: vec![],
+        b: vec![],
+        pulse: vec![],
+        encoder: vec![],
+    };
     for i in 0..n {
         let phi = w * i as f64 / fs + 0.3; // recording starts 0.3 rad after the mark
         s.a.push(1.0 - rho * (lambda + phi).cos() + noise.sample(&mut rng));
         s.b.push(1.0 - rho * (lambda + phi - PI / 2.0).cos() + noise.sample(&mut rng));
-        s.pulse.push(if phi.rem_euclid(TAU) < 0.2 { 5.0 } else { 0.0 });
+        s.pulse
+            .push(if phi.rem_euclid(TAU) < 0.2 { 5.0 } else { 0.0 });
         s.encoder.push(phi.rem_euclid(TAU));
     }
     s
@@ -338,8 +399,16 @@ fn input<'a>(s: &'a Sim, fs: f64, reference: SpindleReference<'a>) -> SignalInpu
     SignalInput {
         sample_rate_hz: fs,
         channels: vec![
-            SensorChannel { displacement_mm: &s.a, angle_rad: 0.0, sign: SensorSign::Distance },
-            SensorChannel { displacement_mm: &s.b, angle_rad: PI / 2.0, sign: SensorSign::Distance },
+            SensorChannel {
+                displacement_mm: &s.a,
+                angle_rad: 0.0,
+                sign: SensorSign::Distance,
+            },
+            SensorChannel {
+                displacement_mm: &s.b,
+                angle_rad: PI / 2.0,
+                sign: SensorSign::Distance,
+            },
         ],
         reference,
         surface_radius_mm: 5.0,
@@ -360,7 +429,11 @@ fn raw_signal_issue_case() {
     let s = simulate(n, fs, 3240.0, 0.008, 30f64.to_radians(), sigma, 31);
     // with the once-per-rev mark: λ is relative to the mark
     let (fit, track) = fit_signal(&input(&s, fs, SpindleReference::Pulse(&s.pulse))).unwrap();
-    eprintln!("signal/pulse: ρ {:.5} µm, λ {:.4}°", fit.offset_mm * 1e3, fit.angle.angle().unwrap().to_degrees());
+    eprintln!(
+        "signal/pulse: ρ {:.5} µm, λ {:.4}°",
+        fit.offset_mm * 1e3,
+        fit.angle.angle().unwrap().to_degrees()
+    );
     assert!((fit.offset_mm - 0.008).abs() < 0.05e-3, "{}", fit.offset_mm);
     let l = fit.angle.angle().unwrap().to_degrees();
     assert!((l - 30.0).abs() < 0.5, "{l}");
@@ -369,7 +442,8 @@ fn raw_signal_issue_case() {
     // reported σ matches the expected order (σ/sqrt(N) scaling)
     assert!(fit.offset_se_mm < 5e-6 && fit.offset_se_mm > 5e-7);
     // seed eq. (5) per revolution: half TIR ≈ ρ + noise extremes (biased up by noise, ~3σ)
-    let revs = per_revolution_runout(&input(&s, fs, SpindleReference::Pulse(&s.pulse)), &track).unwrap();
+    let revs =
+        per_revolution_runout(&input(&s, fs, SpindleReference::Pulse(&s.pulse)), &track).unwrap();
     assert!(revs[0].mean_mm > 0.008 && revs[0].mean_mm < 0.008 + 5.0 * sigma);
 
     // encoder: same answer
@@ -378,13 +452,28 @@ fn raw_signal_issue_case() {
     assert!((enc.angle.angle().unwrap().to_degrees() - 30.0).abs() < 0.5);
 
     // no reference: speed from the spectrum, angle relative to the first sample (φ₀ = 0.3 rad)
-    let est = input(&s, fs, SpindleReference::Estimate { rpm_min: 600.0, rpm_max: 30000.0 });
+    let est = input(
+        &s,
+        fs,
+        SpindleReference::Estimate {
+            rpm_min: 600.0,
+            rpm_max: 30000.0,
+        },
+    );
     let (fit, _) = fit_signal(&est).unwrap();
-    eprintln!("signal/estimated: rpm {:.5}, ρ {:.5} µm, λ−φ₀ {:.4}°", fit.rpm, fit.offset_mm * 1e3, fit.angle.angle().unwrap().to_degrees() - 0.3f64.to_degrees());
+    eprintln!(
+        "signal/estimated: rpm {:.5}, ρ {:.5} µm, λ−φ₀ {:.4}°",
+        fit.rpm,
+        fit.offset_mm * 1e3,
+        fit.angle.angle().unwrap().to_degrees() - 0.3f64.to_degrees()
+    );
     assert!((fit.rpm - 3240.0).abs() < 1e-3, "{}", fit.rpm);
     assert!((fit.offset_mm - 0.008).abs() < 0.05e-3);
     let l = fit.angle.angle().unwrap().to_degrees();
-    assert!(runout_core::angle::wrap_deg180(l - 30.0 - 0.3f64.to_degrees()).abs() < 0.5, "{l}");
+    assert!(
+        runout_core::angle::wrap_deg180(l - 30.0 - 0.3f64.to_degrees()).abs() < 0.5,
+        "{l}"
+    );
 }
 
 /// A toothed profile (K = 3, R = 0.25 mm) read slowly: per-tooth extrema in the angular windows
@@ -413,7 +502,11 @@ fn per_tooth_extrema_from_signal() {
     }
     let inp = SignalInput {
         sample_rate_hz: fs,
-        channels: vec![SensorChannel { displacement_mm: &d, angle_rad: beta, sign: SensorSign::Radial }],
+        channels: vec![SensorChannel {
+            displacement_mm: &d,
+            angle_rad: beta,
+            sign: SensorSign::Radial,
+        }],
         reference: SpindleReference::Pulse(&pulse),
         surface_radius_mm: R_MICRO,
         beam: BeamGeometry::ideal(),
@@ -448,7 +541,10 @@ fn bad_inputs_give_clear_errors() {
     let mut o = opts(micro(2));
     o.known_offset_mm = Some(0.002);
     let e = identify_from_teeth(&readings(&[0.005, 0.0]), &o).unwrap_err();
-    assert!(matches!(e, DisplacementError::InconsistentDifference { .. }), "{e}");
+    assert!(
+        matches!(e, DisplacementError::InconsistentDifference { .. }),
+        "{e}"
+    );
     // … but within 3σ of the noise it is clamped and flagged
     o.noise_mm = Some(0.0005);
     let f = identify_from_teeth(&readings(&[0.0045, 0.0]), &o).unwrap();
@@ -457,11 +553,20 @@ fn bad_inputs_give_clear_errors() {
     let e = identify_from_teeth(&readings(&[0.001, 0.0]), &opts(micro(2))).unwrap_err();
     assert!(matches!(e, DisplacementError::NeedsOffset { .. }));
     // heights all equal
-    let e = runout_at_height(&[(2.0, 0.003), (2.0, 0.004)], 0.0, HeightRegression::Ols).unwrap_err();
+    let e =
+        runout_at_height(&[(2.0, 0.003), (2.0, 0.004)], 0.0, HeightRegression::Ols).unwrap_err();
     assert!(matches!(e, DisplacementError::HeightsEqual { .. }));
     let e = runout_at_height(&[(2.0, 0.003)], 0.0, HeightRegression::Ols).unwrap_err();
-    assert!(matches!(e, DisplacementError::TooFew { got: 1, need: 2, .. }));
-    let e = runout_at_height(&[(1.0, f64::NAN), (2.0, 0.1)], 0.0, HeightRegression::Ols).unwrap_err();
+    assert!(matches!(
+        e,
+        DisplacementError::TooFew {
+            got: 1,
+            need: 2,
+            ..
+        }
+    ));
+    let e =
+        runout_at_height(&[(1.0, f64::NAN), (2.0, 0.1)], 0.0, HeightRegression::Ols).unwrap_err();
     assert!(matches!(e, DisplacementError::NotFinite { .. }));
     // signals: no channel, reference of the wrong length, constant pulse, one mark
     let x = vec![0.0; 1000];
@@ -474,15 +579,31 @@ fn bad_inputs_give_clear_errors() {
         beam: BeamGeometry::ideal(),
         reference_angle_rad: 0.0,
     };
-    assert!(fit_signal(&inp).unwrap_err().to_string().contains("no displacement channel"));
-    inp.channels.push(SensorChannel { displacement_mm: &x, angle_rad: 0.0, sign: SensorSign::Radial });
-    assert!(fit_signal(&inp).unwrap_err().to_string().contains("constant"));
+    assert!(fit_signal(&inp)
+        .unwrap_err()
+        .to_string()
+        .contains("no displacement channel"));
+    inp.channels.push(SensorChannel {
+        displacement_mm: &x,
+        angle_rad: 0.0,
+        sign: SensorSign::Radial,
+    });
+    assert!(fit_signal(&inp)
+        .unwrap_err()
+        .to_string()
+        .contains("constant"));
     inp.reference = SpindleReference::Pulse(&short);
-    assert!(fit_signal(&inp).unwrap_err().to_string().contains("reference channel has 10"));
+    assert!(fit_signal(&inp)
+        .unwrap_err()
+        .to_string()
+        .contains("reference channel has 10"));
     let mut one = vec![0.0; 1000];
     one[500] = 1.0;
     inp.reference = SpindleReference::Pulse(&one);
-    assert!(fit_signal(&inp).unwrap_err().to_string().contains("1 once-per-revolution mark"));
+    assert!(fit_signal(&inp)
+        .unwrap_err()
+        .to_string()
+        .contains("1 once-per-revolution mark"));
 }
 
 /// Ill-posed cases are flagged, never a silently wrong angle (methods.md §1.5).
@@ -492,17 +613,24 @@ fn ill_posed_cases_are_flagged() {
     let mut o = opts(micro(3));
     o.noise_mm = Some(1e-4);
     let fit = identify_from_teeth(&readings(&radii(&micro(3), 0.0002, 50.0)), &o).unwrap();
-    assert!(matches!(fit.angle, AngleEstimate::Undetermined { .. }), "{:?}", fit.angle);
+    assert!(
+        matches!(fit.angle, AngleEstimate::Undetermined { .. }),
+        "{:?}",
+        fit.angle
+    );
     // K = 2 near θ = 0: σ_λ = σ_P/(√2 ρ sin 2°) = 23° → undetermined even with the hint
     let mut o = opts(micro(2));
     o.known_offset_mm = Some(0.005);
     o.noise_mm = Some(1e-4);
     o.phase_hint_rad = Some(0.0);
     let fit = identify_from_teeth(&readings(&radii(&micro(2), 0.005, 2.0)), &o).unwrap();
-    let AngleEstimate::Undetermined { reason, .. } = &fit.angle else { panic!("{:?}", fit.angle) };
+    let AngleEstimate::Undetermined { reason, .. } = &fit.angle else {
+        panic!("{:?}", fit.angle)
+    };
     assert!(reason.contains("K = 2"));
     // K = 3 without any noise information: determined but flagged, se unknown
-    let fit = identify_from_teeth(&readings(&radii(&micro(3), 0.005, 50.0)), &opts(micro(3))).unwrap();
+    let fit =
+        identify_from_teeth(&readings(&radii(&micro(3), 0.005, 50.0)), &opts(micro(3))).unwrap();
     assert_eq!(fit.noise_source, NoiseSource::Unknown);
     assert!(fit.angle.se().is_none() && fit.notes.iter().any(|n| n.contains("no noise estimate")));
     // K ≥ 3 consistency check against the height-regression offset (§1.5 step 4)
@@ -595,4 +723,3 @@ proptest! {
         prop_assert!(dl.abs() < 0.2, "{}", dl);
     }
 }
-

@@ -172,7 +172,9 @@ impl Table {
     fn number(&self, r: usize, col: &Column) -> Result<f64, TableError> {
         let (line, rec) = &self.rows[r];
         let text = rec.get(col.index).unwrap_or("");
-        let v: f64 = text.parse().map_err(|_| self.cell_error(*line, col, format!("`{text}` is not a number")))?;
+        let v: f64 = text
+            .parse()
+            .map_err(|_| self.cell_error(*line, col, format!("`{text}` is not a number")))?;
         if !v.is_finite() {
             return Err(self.cell_error(*line, col, format!("`{text}` is not a finite number")));
         }
@@ -214,18 +216,28 @@ pub fn read_tooth_table(path: &Path, teeth: usize) -> Result<ToothTable, TableEr
                 message: "both `tooth` and `seed_edge` columns: give one numbering".into(),
             })
         }
-        (None, None) => return Err(t.missing("`tooth` (0-based, cutting order) or `seed_edge` (1-based)")),
+        (None, None) => {
+            return Err(t.missing("`tooth` (0-based, cutting order) or `seed_edge` (1-based)"))
+        }
     };
     let mut readings = Vec::with_capacity(t.rows.len());
     for r in 0..t.rows.len() {
         let (line, rec) = &t.rows[r];
         let text = rec.get(tooth_col.index).unwrap_or("");
         let n: usize = text.parse().map_err(|_| {
-            t.cell_error(*line, &tooth_col, format!("`{text}` is not a tooth number (integer)"))
+            t.cell_error(
+                *line,
+                &tooth_col,
+                format!("`{text}` is not a tooth number (integer)"),
+            )
         })?;
         let tooth = if seed {
             tooth_from_seed000_edge(n, teeth).ok_or_else(|| {
-                t.cell_error(*line, &tooth_col, format!("seed edge {n} is not in 1..={teeth}"))
+                t.cell_error(
+                    *line,
+                    &tooth_col,
+                    format!("seed edge {n} is not in 1..={teeth}"),
+                )
             })?
         } else if n < teeth {
             n
@@ -273,14 +285,22 @@ pub fn read_height_table(path: &Path) -> Result<Vec<HeightRow>, TableError> {
                 message: "both `tir_*` and `runout_*` columns: give one".into(),
             })
         }
-        (None, None) => return Err(t.missing("`tir_<unit>` (total indicated runout) or `runout_<unit>` (= TIR/2)")),
+        (None, None) => {
+            return Err(
+                t.missing("`tir_<unit>` (total indicated runout) or `runout_<unit>` (= TIR/2)")
+            )
+        }
     };
     let angle = t.unit_column("angle", Quantity::AngleDeg)?;
     (0..t.rows.len())
         .map(|r| {
             let v = t.number(r, &value)?;
             if v < 0.0 {
-                return Err(t.cell_error(t.rows[r].0, &value, format!("{v} is negative; runout and TIR are ≥ 0")));
+                return Err(t.cell_error(
+                    t.rows[r].0,
+                    &value,
+                    format!("{v} is negative; runout and TIR are ≥ 0"),
+                ));
             }
             Ok(HeightRow {
                 z_mm: t.number(r, &z)?,
@@ -334,26 +354,44 @@ pub fn read_signal(path: &Path) -> Result<SignalTable, TableError> {
         })
         .collect::<Result<_, TableError>>()?;
     if disp.is_empty() {
-        return Err(t.missing("`disp_<name>_<unit>` (e.g. disp_a_um): at least one displacement channel"));
+        return Err(
+            t.missing("`disp_<name>_<unit>` (e.g. disp_a_um): at least one displacement channel")
+        );
     }
     let n = t.rows.len();
-    let times: Vec<f64> = (0..n).map(|r| t.number(r, &time)).collect::<Result<_, _>>()?;
+    let times: Vec<f64> = (0..n)
+        .map(|r| t.number(r, &time))
+        .collect::<Result<_, _>>()?;
     let sample_rate_hz = check_time_grid(&t, &time, &times)?;
     let channels = disp
         .iter()
         .map(|c| {
-            let v = (0..n).map(|r| t.number(r, c)).collect::<Result<Vec<f64>, _>>()?;
-            let name = c.name.trim_start_matches("disp_").rsplit_once('_').map_or(c.name.clone(), |x| x.0.to_string());
+            let v = (0..n)
+                .map(|r| t.number(r, c))
+                .collect::<Result<Vec<f64>, _>>()?;
+            let name = c
+                .name
+                .trim_start_matches("disp_")
+                .rsplit_once('_')
+                .map_or(c.name.clone(), |x| x.0.to_string());
             Ok((name, v))
         })
         .collect::<Result<_, TableError>>()?;
     let pulse = t
         .plain_column("pulse")
-        .map(|c| (0..n).map(|r| t.number(r, &c)).collect::<Result<Vec<f64>, _>>())
+        .map(|c| {
+            (0..n)
+                .map(|r| t.number(r, &c))
+                .collect::<Result<Vec<f64>, _>>()
+        })
         .transpose()?;
     let encoder_rad = t
         .unit_column("encoder", Quantity::AngleDeg)?
-        .map(|c| (0..n).map(|r| t.number(r, &c).map(f64::to_radians)).collect::<Result<Vec<f64>, _>>())
+        .map(|c| {
+            (0..n)
+                .map(|r| t.number(r, &c).map(f64::to_radians))
+                .collect::<Result<Vec<f64>, _>>()
+        })
         .transpose()?;
     Ok(SignalTable {
         sample_rate_hz,

@@ -30,10 +30,15 @@ pub struct TeethPlot {
 /// the first-order radius curve ρ·cos(ψ − λ) and the runout vector (arrow), all in µm. The radius
 /// drawn is `base + deviation` with base = 3·max(|dev|, ρ) so that deviations stay visible.
 pub fn teeth_polar_plot(path: &Path, d: &TeethPlot) -> Result<(), PlotError> {
-    render_plot!(path, (760, 760), |root: &DrawingArea<_, Shift>| draw_teeth(root, d))
+    render_plot!(path, (760, 760), |root: &DrawingArea<_, Shift>| draw_teeth(
+        root, d
+    ))
 }
 
-fn draw_teeth<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &TeethPlot) -> Result<(), String> {
+fn draw_teeth<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    d: &TeethPlot,
+) -> Result<(), String> {
     root.fill(&WHITE).map_err(e2s)?;
     let dev_max = d
         .measured_um
@@ -52,7 +57,9 @@ fn draw_teeth<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &TeethPlot) 
         .map_err(e2s)?;
     chart
         .configure_mesh()
-        .x_desc(format!("spindle frame x (µm; radius = {base:.2} µm + deviation)"))
+        .x_desc(format!(
+            "spindle frame x (µm; radius = {base:.2} µm + deviation)"
+        ))
         .y_desc("spindle frame y (µm)")
         .draw()
         .map_err(e2s)?;
@@ -65,7 +72,10 @@ fn draw_teeth<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &TeethPlot) 
             .collect()
     };
     chart
-        .draw_series(LineSeries::new(circle(&|_| base), BLACK.mix(0.4).stroke_width(1)))
+        .draw_series(LineSeries::new(
+            circle(&|_| base),
+            BLACK.mix(0.4).stroke_width(1),
+        ))
         .map_err(e2s)?
         .label("nominal radius")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.mix(0.4)));
@@ -77,25 +87,45 @@ fn draw_teeth<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &TeethPlot) 
                 colour(0).stroke_width(2),
             ))
             .map_err(e2s)?
-            .label(format!("first order ρ·cos(ψ − λ), ρ = {rho:.3} µm, λ = {:.2}°", l.to_degrees()))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour(0).stroke_width(2)));
+            .label(format!(
+                "first order ρ·cos(ψ − λ), ρ = {rho:.3} µm, λ = {:.2}°",
+                l.to_degrees()
+            ))
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], colour(0).stroke_width(2))
+            });
         let tip = (rho * l.cos(), rho * l.sin());
         chart
-            .draw_series(LineSeries::new(vec![(0.0, 0.0), tip], colour(3).stroke_width(3)))
+            .draw_series(LineSeries::new(
+                vec![(0.0, 0.0), tip],
+                colour(3).stroke_width(3),
+            ))
             .map_err(e2s)?
             .label("runout vector e (µm, true scale)")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour(3).stroke_width(3)));
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], colour(3).stroke_width(3))
+            });
         chart
             .draw_series(std::iter::once(Circle::new(tip, 5, colour(3).filled())))
             .map_err(e2s)?;
     }
     let pt = |a: f64, v: f64| ((base + v) * a.cos(), (base + v) * a.sin());
     chart
-        .draw_series(d.tooth_angles_rad.iter().zip(&d.measured_um).enumerate().map(|(i, (a, v))| {
-            EmptyElement::at(pt(*a, *v))
-                + Circle::new((0, 0), 6, colour(1).filled())
-                + Text::new(format!("tooth {i}: {v:+.3} µm"), (8, -14), ("sans-serif", 14))
-        }))
+        .draw_series(
+            d.tooth_angles_rad
+                .iter()
+                .zip(&d.measured_um)
+                .enumerate()
+                .map(|(i, (a, v))| {
+                    EmptyElement::at(pt(*a, *v))
+                        + Circle::new((0, 0), 6, colour(1).filled())
+                        + Text::new(
+                            format!("tooth {i}: {v:+.3} µm"),
+                            (8, -14),
+                            ("sans-serif", 14),
+                        )
+                }),
+        )
         .map_err(e2s)?
         .label("measured (tooth tip)")
         .legend(|(x, y)| Circle::new((x + 9, y), 5, colour(1).filled()));
@@ -139,21 +169,35 @@ pub struct HeightPlot {
 /// Runout vs height: measured points, the regression line (extrapolated to the cutting height)
 /// and the result with its ±2σ bar.
 pub fn height_plot(path: &Path, d: &HeightPlot) -> Result<(), PlotError> {
-    render_plot!(path, (900, 560), |root: &DrawingArea<_, Shift>| draw_heights(root, d))
+    render_plot!(path, (900, 560), |root: &DrawingArea<_, Shift>| {
+        draw_heights(root, d)
+    })
 }
 
-fn draw_heights<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &HeightPlot) -> Result<(), String> {
+fn draw_heights<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    d: &HeightPlot,
+) -> Result<(), String> {
     root.fill(&WHITE).map_err(e2s)?;
     let se = d.at.2.unwrap_or(0.0);
-    let xs = d.points.iter().map(|p| p.0).chain(d.line.iter().map(|p| p.0)).chain([d.at.0]);
+    let xs = d
+        .points
+        .iter()
+        .map(|p| p.0)
+        .chain(d.line.iter().map(|p| p.0))
+        .chain([d.at.0]);
     let ys = d
         .points
         .iter()
         .map(|p| p.1)
         .chain(d.line.iter().map(|p| p.1))
         .chain([d.at.1 - 2.0 * se, d.at.1 + 2.0 * se, 0.0]);
-    let (x0, x1) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
-    let (y0, y1) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    let (x0, x1) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    let (y0, y1) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
     let (px, py) = (0.05 * (x1 - x0).max(1e-6), 0.08 * (y1 - y0).max(1e-6));
     let mut chart = ChartBuilder::on(root)
         .caption(&d.title, ("sans-serif", 20))
@@ -169,21 +213,35 @@ fn draw_heights<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, d: &HeightPlo
         .draw()
         .map_err(e2s)?;
     chart
-        .draw_series(LineSeries::new(d.line.iter().copied(), colour(0).stroke_width(2)))
+        .draw_series(LineSeries::new(
+            d.line.iter().copied(),
+            colour(0).stroke_width(2),
+        ))
         .map_err(e2s)?
         .label(d.line_label.clone())
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour(0).stroke_width(2)));
     chart
-        .draw_series(d.points.iter().map(|p| Circle::new(*p, 5, colour(1).filled())))
+        .draw_series(
+            d.points
+                .iter()
+                .map(|p| Circle::new(*p, 5, colour(1).filled())),
+        )
         .map_err(e2s)?
         .label("measured")
         .legend(|(x, y)| Circle::new((x + 9, y), 5, colour(1).filled()));
     let (z, r, _) = d.at;
     chart
-        .draw_series(LineSeries::new(vec![(z, r - 2.0 * se), (z, r + 2.0 * se)], colour(3).stroke_width(2)))
+        .draw_series(LineSeries::new(
+            vec![(z, r - 2.0 * se), (z, r + 2.0 * se)],
+            colour(3).stroke_width(2),
+        ))
         .map_err(e2s)?;
     chart
-        .draw_series(std::iter::once(TriangleMarker::new((z, r), 8, colour(3).filled())))
+        .draw_series(std::iter::once(TriangleMarker::new(
+            (z, r),
+            8,
+            colour(3).filled(),
+        )))
         .map_err(e2s)?
         .label(format!("z = {z} mm: {r:.3} µm ± 2σ"))
         .legend(|(x, y)| TriangleMarker::new((x + 9, y), 6, colour(3).filled()));

@@ -78,7 +78,10 @@ impl BeamGeometry {
         if self.offset.abs() >= 0.9 * radius_mm {
             return Err(ParamError::new(
                 "beam_offset_mm",
-                format!("|b| < 0.9·R = {:.4} mm (the beam must hit the tool near its axis)", 0.9 * radius_mm),
+                format!(
+                    "|b| < 0.9·R = {:.4} mm (the beam must hit the tool near its axis)",
+                    0.9 * radius_mm
+                ),
                 self.offset,
             )
             .into());

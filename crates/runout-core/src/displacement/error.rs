@@ -18,7 +18,9 @@ pub enum DisplacementError {
         missing: Vec<usize>,
     },
     /// A reading refers to a tooth that does not exist.
-    #[error("reading {index} refers to tooth {tooth}, but the cutter has {teeth} teeth (0..{teeth})")]
+    #[error(
+        "reading {index} refers to tooth {tooth}, but the cutter has {teeth} teeth (0..{teeth})"
+    )]
     ToothOutOfRange {
         /// Index of the reading.
         index: usize,

@@ -146,7 +146,9 @@ pub fn identify_from_teeth(
         });
     }
     check_known_offset(opts)?;
-    let factor = opts.beam.amplitude_factor(opts.cutter.radius_at(opts.height_mm))?;
+    let factor = opts
+        .beam
+        .amplitude_factor(opts.cutter.radius_at(opts.height_mm))?;
     let readings = readings.scaled(factor);
     let (noise, noise_source) = noise_level(&readings, opts, factor);
     match (opts.method, k) {
@@ -176,7 +178,11 @@ fn check_known_offset(opts: &ToothFitOptions) -> Result<(), DisplacementError> {
 }
 
 /// σ_P of one (beam-corrected) reading: given > repeats; the residual is used later if neither.
-fn noise_level(r: &ToothReadings, opts: &ToothFitOptions, factor: f64) -> (Option<f64>, NoiseSource) {
+fn noise_level(
+    r: &ToothReadings,
+    opts: &ToothFitOptions,
+    factor: f64,
+) -> (Option<f64>, NoiseSource) {
     if let Some(s) = opts.noise_mm {
         (Some(s * factor), NoiseSource::Given)
     } else if let Some(s) = r.repeat_noise() {
@@ -222,7 +228,12 @@ impl LeastSquaresProblem<f64, Dyn, U3> for PositionsProblem<'_> {
         ))
     }
     fn jacobian(&self) -> Option<OMatrix<f64, Dyn, U3>> {
-        Some(positions_jacobian(self.cutter, self.z, [self.x[1], self.x[2]], &self.w))
+        Some(positions_jacobian(
+            self.cutter,
+            self.z,
+            [self.x[1], self.x[2]],
+            &self.w,
+        ))
     }
 }
 
@@ -255,7 +266,10 @@ fn linear_start(cutter: &Cutter, z: f64, p: &[f64], w: &[f64]) -> Option<Vector3
 }
 
 fn weights(r: &ToothReadings) -> Vec<f64> {
-    r.samples().iter().map(|s| (s.len() as f64).sqrt()).collect()
+    r.samples()
+        .iter()
+        .map(|s| (s.len() as f64).sqrt())
+        .collect()
 }
 
 fn joint(
@@ -372,7 +386,10 @@ fn two_teeth(
             "the K = 2 closed form needs uniform pitch; use the scan method".into(),
         ));
     }
-    let rho = required_offset(opts, "K = 2 gives one equation for two unknowns (methods.md §1.5)")?;
+    let rho = required_offset(
+        opts,
+        "K = 2 gives one equation for two unknowns (methods.md §1.5)",
+    )?;
     let (z, r) = (opts.height_mm, cutter.radius_at(opts.height_mm));
     let p = readings.positions();
     let delta = p[0] - p[1];
@@ -388,10 +405,19 @@ fn two_teeth(
     };
     let theta = cos_t.acos();
     let psi0 = cutter.tooth_angle(0, z);
-    let se = two_teeth_se(cutter, z, rho, psi0 + theta, sigma_delta, opts.known_offset_se_mm);
+    let se = two_teeth_se(
+        cutter,
+        z,
+        rho,
+        psi0 + theta,
+        sigma_delta,
+        opts.known_offset_se_mm,
+    );
     let angle = resolve_mirror(psi0, theta, se, rho, opts.phase_hint_rad, &mut notes);
     if noise.is_none() {
-        notes.push("no noise estimate: σ_λ unknown; give the sensor noise or repeat the readings".into());
+        notes.push(
+            "no noise estimate: σ_λ unknown; give the sensor noise or repeat the readings".into(),
+        );
     }
     Ok(ToothFit {
         method: ToothMethod::Joint,
@@ -455,10 +481,15 @@ fn two_teeth_se(
     let h = 1e-6;
     let dl = (d(rho, lambda + h) - d(rho, lambda - h)) / (2.0 * h);
     let hr = 1e-6 * rho.max(1e-6);
-    let dr = (d(rho + hr, lambda) - d((rho - hr).max(0.0), lambda)) / (rho + hr - (rho - hr).max(0.0));
+    let dr =
+        (d(rho + hr, lambda) - d((rho - hr).max(0.0), lambda)) / (rho + hr - (rho - hr).max(0.0));
     let s = sigma_delta?;
     let var = s * s + (dr * rho_se.unwrap_or(0.0)).powi(2);
-    Some(if dl == 0.0 { f64::INFINITY } else { var.sqrt() / dl.abs() })
+    Some(if dl == 0.0 {
+        f64::INFINITY
+    } else {
+        var.sqrt() / dl.abs()
+    })
 }
 
 /// Two mirror candidates λ = ψ₀ ± θ'; pick by the phase hint when given (methods.md §1.5 "K = 2").

@@ -2,7 +2,9 @@
 //! height (methods.md §1.3; §1.6 vector fit when the table has an angle column).
 
 use super::*;
-use runout_core::displacement::{runout_at_height, vector_at_height, HeightFit, HeightRegression, VectorHeightFit};
+use runout_core::displacement::{
+    runout_at_height, vector_at_height, HeightFit, HeightRegression, VectorHeightFit,
+};
 use runout_io::displacement::{read_height_table, HeightRow};
 use runout_io::displacement_plot::{height_plot, HeightPlot};
 
@@ -33,7 +35,9 @@ pub fn run(a: Args) -> Result<()> {
     let file = a.table.display().to_string();
     let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.z_mm, r.runout_mm)).collect();
     let fit = runout_at_height(&pts, at, method).with_context(|| file.clone())?;
-    let vector = vector_fit(&rows, at).transpose().with_context(|| file.clone())?;
+    let vector = vector_fit(&rows, at)
+        .transpose()
+        .with_context(|| file.clone())?;
     let json = to_json(&file, &fit, vector.as_ref());
     let text = to_text(&file, &fit, vector.as_ref());
     if let Some(p) = &a.out.plot {
@@ -43,22 +47,34 @@ pub fn run(a: Args) -> Result<()> {
     a.out.write(&a.table, &json, &text)
 }
 
-fn vector_fit(rows: &[HeightRow], at: f64) -> Option<Result<VectorHeightFit, runout_core::displacement::DisplacementError>> {
+fn vector_fit(
+    rows: &[HeightRow],
+    at: f64,
+) -> Option<Result<VectorHeightFit, runout_core::displacement::DisplacementError>> {
     let pts: Option<Vec<(f64, [f64; 2])>> = rows
         .iter()
-        .map(|r| r.angle_rad.map(|l| (r.z_mm, [r.runout_mm * l.cos(), r.runout_mm * l.sin()])))
+        .map(|r| {
+            r.angle_rad
+                .map(|l| (r.z_mm, [r.runout_mm * l.cos(), r.runout_mm * l.sin()]))
+        })
         .collect();
     pts.map(|p| vector_at_height(&p, at))
 }
 
 fn plot_data(pts: &[(f64, f64)], fit: &HeightFit) -> HeightPlot {
     let zs = pts.iter().map(|p| p.0).chain([fit.height_mm]);
-    let (z0, z1) = zs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), z| (a.min(z), b.max(z)));
+    let (z0, z1) = zs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), z| {
+        (a.min(z), b.max(z))
+    });
     HeightPlot {
         points: pts.iter().map(|(z, r)| (*z, r * 1e3)).collect(),
         line: vec![(z0, fit.at(z0) * 1e3), (z1, fit.at(z1) * 1e3)],
         line_label: format!("{:?} fit, R² = {:.4}", fit.method, fit.r_squared),
-        at: (fit.height_mm, fit.offset_mm * 1e3, fit.offset_se_mm.map(|s| s * 1e3)),
+        at: (
+            fit.height_mm,
+            fit.offset_mm * 1e3,
+            fit.offset_se_mm.map(|s| s * 1e3),
+        ),
         title: "runout vs height (r = TIR/2)".into(),
     }
 }
@@ -93,10 +109,22 @@ fn to_json(file: &str, fit: &HeightFit, vector: Option<&VectorHeightFit>) -> Val
 }
 
 fn to_text(file: &str, fit: &HeightFit, vector: Option<&VectorHeightFit>) -> String {
-    let mut s = format!("runout vs height ({file}; {} heights, {:?})\n", fit.points, fit.method);
+    let mut s = format!(
+        "runout vs height ({file}; {} heights, {:?})\n",
+        fit.points, fit.method
+    );
     s += &match fit.offset_se_mm {
-        Some(se) => format!("runout at z = {} mm: {:.3} ± {:.3} µm (1σ)\n", fit.height_mm, fit.offset_mm * 1e3, se * 1e3),
-        None => format!("runout at z = {} mm: {:.3} µm\n", fit.height_mm, fit.offset_mm * 1e3),
+        Some(se) => format!(
+            "runout at z = {} mm: {:.3} ± {:.3} µm (1σ)\n",
+            fit.height_mm,
+            fit.offset_mm * 1e3,
+            se * 1e3
+        ),
+        None => format!(
+            "runout at z = {} mm: {:.3} µm\n",
+            fit.height_mm,
+            fit.offset_mm * 1e3
+        ),
     };
     s += &format!(
         "slope {:.4} µm/mm, R² {:.4}, residual rms {:.4} µm\n",

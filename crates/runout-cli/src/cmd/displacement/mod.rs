@@ -7,7 +7,9 @@ mod signal;
 mod teeth;
 
 use anyhow::{bail, Context, Result};
-use runout_core::displacement::{consequences, AngleEstimate, BeamGeometry, Consequences, SensorSign};
+use runout_core::displacement::{
+    consequences, AngleEstimate, BeamGeometry, Consequences, SensorSign,
+};
 use runout_core::{Cutter, Runout};
 use runout_io::units::{parse_quantity, Quantity};
 use serde_json::{json, Value};
@@ -172,8 +174,10 @@ pub struct BeamFlags {
 impl BeamFlags {
     /// The beam geometry.
     pub fn beam(&self) -> Result<BeamGeometry> {
-        let inc = quantity("inclination-deg", &self.inclination_deg, Quantity::AngleDeg)?.unwrap_or(0.0);
-        let b = quantity("beam-offset-mm", &self.beam_offset_mm, Quantity::LengthMm)?.unwrap_or(0.0);
+        let inc =
+            quantity("inclination-deg", &self.inclination_deg, Quantity::AngleDeg)?.unwrap_or(0.0);
+        let b =
+            quantity("beam-offset-mm", &self.beam_offset_mm, Quantity::LengthMm)?.unwrap_or(0.0);
         Ok(BeamGeometry::new(inc.to_radians(), b)?)
     }
     /// JSON echo.
@@ -194,12 +198,20 @@ pub fn angle_json(a: &AngleEstimate) -> Value {
         AngleEstimate::Determined { angle_rad, .. } => json!({
             "angle_status": "determined", "angle_deg": angle_rad.to_degrees(), "angle_se_deg": se,
         }),
-        AngleEstimate::Ambiguous { candidates_rad, reason, .. } => json!({
+        AngleEstimate::Ambiguous {
+            candidates_rad,
+            reason,
+            ..
+        } => json!({
             "angle_status": "ambiguous", "angle_deg": null, "angle_se_deg": se,
             "angle_candidates_deg": [candidates_rad[0].to_degrees(), candidates_rad[1].to_degrees()],
             "angle_reason": reason,
         }),
-        AngleEstimate::Undetermined { reason, rejected_rad, .. } => json!({
+        AngleEstimate::Undetermined {
+            reason,
+            rejected_rad,
+            ..
+        } => json!({
             "angle_status": "undetermined", "angle_deg": null, "angle_se_deg": se,
             "angle_rejected_deg": rejected_rad.map(f64::to_degrees), "angle_reason": reason,
         }),
@@ -208,12 +220,20 @@ pub fn angle_json(a: &AngleEstimate) -> Value {
 
 /// Text line of an angle estimate.
 pub fn angle_text(a: &AngleEstimate) -> String {
-    let se = |s: Option<f64>| s.map_or("σ unknown".to_string(), |s| format!("± {:.2}° (1σ)", s.to_degrees()));
+    let se = |s: Option<f64>| {
+        s.map_or("σ unknown".to_string(), |s| {
+            format!("± {:.2}° (1σ)", s.to_degrees())
+        })
+    };
     match a {
         AngleEstimate::Determined { angle_rad, se_rad } => {
             format!("angle λ = {:.2}° {}", angle_rad.to_degrees(), se(*se_rad))
         }
-        AngleEstimate::Ambiguous { candidates_rad, se_rad, reason } => format!(
+        AngleEstimate::Ambiguous {
+            candidates_rad,
+            se_rad,
+            reason,
+        } => format!(
             "angle λ = {:.2}° or {:.2}° {} — AMBIGUOUS: {reason}",
             candidates_rad[0].to_degrees(),
             candidates_rad[1].to_degrees(),

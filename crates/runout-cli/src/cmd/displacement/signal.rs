@@ -49,10 +49,16 @@ pub fn run(a: Args) -> Result<()> {
     let angles = sensor_angles(&a.sensor_angles_deg, table.channels.len())?;
     let beam = a.beam.beam()?;
     let ideal = beam.inclination() == 0.0 && beam.offset() == 0.0;
-    let surface = match quantity("surface-diameter-mm", &a.surface_diameter_mm, Quantity::LengthMm)? {
+    let surface = match quantity(
+        "surface-diameter-mm",
+        &a.surface_diameter_mm,
+        Quantity::LengthMm,
+    )? {
         Some(d) => 0.5 * d,
         None if ideal => 1.0, // unused: the ideal beam needs no radius
-        None => bail!("--surface-diameter-mm is required with --inclination-deg / --beam-offset-mm"),
+        None => {
+            bail!("--surface-diameter-mm is required with --inclination-deg / --beam-offset-mm")
+        }
     };
     let rpm_min = quantity("rpm-min", &a.rpm_min, Quantity::SpeedRpm)?.unwrap_or(60.0);
     let rpm_max = quantity("rpm-max", &a.rpm_max, Quantity::SpeedRpm)?.unwrap_or(60_000.0);
@@ -71,12 +77,18 @@ pub fn run(a: Args) -> Result<()> {
             .channels
             .iter()
             .zip(&angles)
-            .map(|((_, v), b)| SensorChannel { displacement_mm: v, angle_rad: *b, sign })
+            .map(|((_, v), b)| SensorChannel {
+                displacement_mm: v,
+                angle_rad: *b,
+                sign,
+            })
             .collect(),
         reference,
         surface_radius_mm: surface,
         beam,
-        reference_angle_rad: quantity("tooth0-deg", &a.tooth0_deg, Quantity::AngleDeg)?.unwrap_or(0.0).to_radians(),
+        reference_angle_rad: quantity("tooth0-deg", &a.tooth0_deg, Quantity::AngleDeg)?
+            .unwrap_or(0.0)
+            .to_radians(),
     };
     let (fit, track) = fit_signal(&input).with_context(|| file.clone())?;
     let revs = per_revolution_runout(&input, &track)?;
@@ -107,13 +119,15 @@ pub fn run(a: Args) -> Result<()> {
     };
     if let Some(cutter) = a.cutter.cutter()? {
         let z = a.cutter.height()?;
-        let readings = per_tooth_extrema(&input, &track, 0, &cutter, z).with_context(|| file.clone())?;
+        let readings =
+            per_tooth_extrema(&input, &track, 0, &cutter, z).with_context(|| file.clone())?;
         let mut opts = ToothFitOptions::new(cutter.clone());
         opts.height_mm = z;
         opts.beam = beam;
         opts.known_offset_mm = Some(fit.offset_mm);
         opts.phase_hint_rad = fit.angle.angle();
-        let tf = identify_from_teeth(&readings, &opts).with_context(|| format!("{file}: per-tooth extrema"))?;
+        let tf = identify_from_teeth(&readings, &opts)
+            .with_context(|| format!("{file}: per-tooth extrema"))?;
         let mut tj = json!({
             "offset_um": tf.offset_mm * 1e3,
             "offset_se_um": tf.offset_se_mm.map(|s| s * 1e3),
@@ -123,7 +137,11 @@ pub fn run(a: Args) -> Result<()> {
         if let (Value::Object(m), Value::Object(x)) = (&mut tj, angle_json(&tf.angle)) {
             m.extend(x);
         }
-        text += &format!("per-tooth extrema (channel 0): offset {:.3} µm, {}\n", tf.offset_mm * 1e3, angle_text(&tf.angle));
+        text += &format!(
+            "per-tooth extrema (channel 0): offset {:.3} µm, {}\n",
+            tf.offset_mm * 1e3,
+            angle_text(&tf.angle)
+        );
         if let Some(r) = tf.runout() {
             let c = a.cutter.consequences(&cutter, &r)?;
             tj["consequences"] = consequences_json(&c);
@@ -131,7 +149,9 @@ pub fn run(a: Args) -> Result<()> {
         }
         json["teeth"] = tj;
         let pm = tf.positions_mm.iter().sum::<f64>() / tf.positions_mm.len() as f64;
-        plot.tooth_angles_rad = (0..cutter.teeth()).map(|i| cutter.tooth_angle(i, z)).collect();
+        plot.tooth_angles_rad = (0..cutter.teeth())
+            .map(|i| cutter.tooth_angle(i, z))
+            .collect();
         plot.measured_um = tf.positions_mm.iter().map(|p| (p - pm) * 1e3).collect();
     }
     if let Some(p) = &a.out.plot {
@@ -154,7 +174,10 @@ fn sensor_angles(v: &Option<String>, n: usize) -> Result<Vec<f64>> {
         .collect::<Result<_, _>>()
         .context("--sensor-angles-deg")?;
     if a.len() != n {
-        bail!("--sensor-angles-deg has {} angle(s), the file has {n} displacement channel(s)", a.len());
+        bail!(
+            "--sensor-angles-deg has {} angle(s), the file has {n} displacement channel(s)",
+            a.len()
+        );
     }
     Ok(a)
 }
@@ -195,7 +218,11 @@ fn to_text(file: &str, ch: &[(String, Vec<f64>)], fit: &SignalFit) -> String {
         fit.rpm,
         fit.revolutions
     );
-    s += &format!("offset ρ = {:.4} ± {:.4} µm (1σ)\n", fit.offset_mm * 1e3, fit.offset_se_mm * 1e3);
+    s += &format!(
+        "offset ρ = {:.4} ± {:.4} µm (1σ)\n",
+        fit.offset_mm * 1e3,
+        fit.offset_se_mm * 1e3
+    );
     s += &angle_text(&fit.angle);
     s += "\n";
     for (c, (name, _)) in fit.channels.iter().zip(ch) {

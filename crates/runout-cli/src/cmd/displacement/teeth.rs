@@ -1,7 +1,9 @@
 //! `runout displacement teeth READINGS.csv`: per-tooth readings → (ρ, λ), methods.md §1.5.
 
 use super::*;
-use runout_core::displacement::{identify_from_teeth, ToothFit, ToothFitOptions, ToothMethod, ToothReadings};
+use runout_core::displacement::{
+    identify_from_teeth, ToothFit, ToothFitOptions, ToothMethod, ToothReadings,
+};
 use runout_io::displacement::read_tooth_table;
 use runout_io::displacement_plot::{teeth_polar_plot, TeethPlot};
 
@@ -53,16 +55,25 @@ pub fn run(a: Args) -> Result<()> {
     opts.known_offset_se_mm = um_as_mm("offset-se-um", &a.offset_se_um)?;
     opts.noise_mm = um_as_mm("noise-um", &a.noise_um)?;
     opts.beam = a.beam.beam()?;
-    opts.phase_hint_rad = quantity("phase-deg", &a.phase_deg, Quantity::AngleDeg)?.map(f64::to_radians);
+    opts.phase_hint_rad =
+        quantity("phase-deg", &a.phase_deg, Quantity::AngleDeg)?.map(f64::to_radians);
     let table = read_tooth_table(&a.readings, k)?;
     let readings = ToothReadings::new(k, &table.readings, sign)
         .with_context(|| format!("{}", a.readings.display()))?;
-    let fit = identify_from_teeth(&readings, &opts).with_context(|| format!("{}", a.readings.display()))?;
+    let fit = identify_from_teeth(&readings, &opts)
+        .with_context(|| format!("{}", a.readings.display()))?;
     let cons = match fit.runout() {
         Some(r) => Some(a.cutter.consequences(&cutter, &r)?),
         None => None,
     };
-    let json = to_json(&a, &cutter, &opts, &fit, cons.as_ref(), table.from_seed_edges)?;
+    let json = to_json(
+        &a,
+        &cutter,
+        &opts,
+        &fit,
+        cons.as_ref(),
+        table.from_seed_edges,
+    )?;
     let text = to_text(&a, &fit, cons.as_ref());
     if let Some(p) = &a.out.plot {
         crate::output::check_not_input(p, &[&a.readings])?;
@@ -80,12 +91,18 @@ fn plot_data(cutter: &Cutter, opts: &ToothFitOptions, fit: &ToothFit) -> TeethPl
         radii.iter().map(|v| (v - m) * 1e3).collect()
     });
     TeethPlot {
-        tooth_angles_rad: (0..cutter.teeth()).map(|i| cutter.tooth_angle(i, opts.height_mm)).collect(),
+        tooth_angles_rad: (0..cutter.teeth())
+            .map(|i| cutter.tooth_angle(i, opts.height_mm))
+            .collect(),
         measured_um: fit.positions_mm.iter().map(|p| (p - pm) * 1e3).collect(),
         model_um: model,
         offset_um: fit.offset_mm * 1e3,
         angle_rad: fit.angle.angle(),
-        title: format!("per-tooth radii, K = {} (runout {:.3} µm)", cutter.teeth(), fit.offset_mm * 1e3),
+        title: format!(
+            "per-tooth radii, K = {} (runout {:.3} µm)",
+            cutter.teeth(),
+            fit.offset_mm * 1e3
+        ),
     }
 }
 
@@ -140,7 +157,11 @@ fn to_text(a: &Args, fit: &ToothFit, cons: Option<&Consequences>) -> String {
         fit.method
     );
     s += &match fit.offset_se_mm {
-        Some(se) => format!("offset ρ = {:.3} ± {:.3} µm (1σ)\n", fit.offset_mm * 1e3, se * 1e3),
+        Some(se) => format!(
+            "offset ρ = {:.3} ± {:.3} µm (1σ)\n",
+            fit.offset_mm * 1e3,
+            se * 1e3
+        ),
         None => format!("offset ρ = {:.3} µm\n", fit.offset_mm * 1e3),
     };
     s += &angle_text(&fit.angle);
@@ -149,11 +170,22 @@ fn to_text(a: &Args, fit: &ToothFit, cons: Option<&Consequences>) -> String {
         "residual rms {:.4} µm, dof {}, noise {} ({:?})\n",
         fit.residual_rms_mm * 1e3,
         fit.dof,
-        fit.noise_mm.map_or("unknown".into(), |n| format!("{:.4} µm", n * 1e3)),
+        fit.noise_mm
+            .map_or("unknown".into(), |n| format!("{:.4} µm", n * 1e3)),
         fit.noise_source
     );
-    for (i, (p, d)) in fit.positions_mm.iter().zip(&fit.radius_differences_mm).enumerate() {
-        s += &format!("  tooth {i}: P = {:.4} µm, ΔR = P{i} − P{} = {:.4} µm\n", p * 1e3, (i + 1) % fit.positions_mm.len(), d * 1e3);
+    for (i, (p, d)) in fit
+        .positions_mm
+        .iter()
+        .zip(&fit.radius_differences_mm)
+        .enumerate()
+    {
+        s += &format!(
+            "  tooth {i}: P = {:.4} µm, ΔR = P{i} − P{} = {:.4} µm\n",
+            p * 1e3,
+            (i + 1) % fit.positions_mm.len(),
+            d * 1e3
+        );
     }
     if let Some(c) = cons {
         s += &consequences_text(c);

@@ -38,7 +38,9 @@ pub fn per_revolution_runout(
                 .map(|&(a, b)| {
                     let (lo, hi) = ch.displacement_mm[a..b]
                         .iter()
-                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| (l.min(x), h.max(x)));
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+                            (l.min(x), h.max(x))
+                        });
                     0.5 * (hi - lo) * factor
                 })
                 .collect();

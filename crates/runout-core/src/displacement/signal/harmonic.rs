@@ -19,7 +19,10 @@ pub(crate) struct HarmonicFit {
 pub(crate) fn fit_harmonics(track: &SpindleTrack, channels: &[&[f64]]) -> Option<Vec<HarmonicFit>> {
     let m = channels.len();
     // Gram sums: n, Σc, Σs, Σcc, Σcs, Σss; per channel: Σx, Σxc, Σxs, Σxx (about a shift for precision)
-    let shift: Vec<f64> = channels.iter().map(|x| x.first().copied().unwrap_or(0.0)).collect();
+    let shift: Vec<f64> = channels
+        .iter()
+        .map(|x| x.first().copied().unwrap_or(0.0))
+        .collect();
     let mut g = [0.0f64; 6];
     let mut acc = vec![[0.0f64; 4]; m];
     track.for_each(|i, c, s| {

@@ -115,7 +115,12 @@ pub struct SignalFit {
 
 fn check_input(input: &SignalInput<'_>) -> Result<usize, DisplacementError> {
     if !(input.sample_rate_hz.is_finite() && input.sample_rate_hz > 0.0) {
-        return Err(crate::ParamError::new("sample_rate_hz", "a finite number > 0", input.sample_rate_hz).into());
+        return Err(crate::ParamError::new(
+            "sample_rate_hz",
+            "a finite number > 0",
+            input.sample_rate_hz,
+        )
+        .into());
     }
     let first = input.channels.first().ok_or_else(|| {
         DisplacementError::Signal("no displacement channel: at least one is needed".into())
@@ -128,9 +133,17 @@ fn check_input(input: &SignalInput<'_>) -> Result<usize, DisplacementError> {
                 ch.displacement_mm.len()
             )));
         }
-        check_finite(&format!("sample of displacement channel {k}"), ch.displacement_mm)?;
+        check_finite(
+            &format!("sample of displacement channel {k}"),
+            ch.displacement_mm,
+        )?;
         if !ch.angle_rad.is_finite() {
-            return Err(crate::ParamError::new("sensor_angle_deg", "a finite number", ch.angle_rad).into());
+            return Err(crate::ParamError::new(
+                "sensor_angle_deg",
+                "a finite number",
+                ch.angle_rad,
+            )
+            .into());
         }
     }
     match input.reference {
@@ -181,7 +194,9 @@ pub fn fit_signal(input: &SignalInput<'_>) -> Result<(SignalFit, SpindleTrack), 
     let shift = input.beam.direction_shift(input.surface_radius_mm)?;
     let sig: Vec<&[f64]> = input.channels.iter().map(|c| c.displacement_mm).collect();
     let fits = harmonic::fit_harmonics(&track, &sig).ok_or_else(|| {
-        DisplacementError::Signal("the spindle angles do not cover a revolution: singular fit".into())
+        DisplacementError::Signal(
+            "the spindle angles do not cover a revolution: singular fit".into(),
+        )
     })?;
     let mut info = Matrix2::zeros();
     let mut info_e = Vector2::zeros();
@@ -198,7 +213,9 @@ pub fn fit_signal(input: &SignalInput<'_>) -> Result<(SignalFit, SpindleTrack), 
         let m = Matrix2::new(cb, sb, sb, -cb);
         let e = m * Vector2::new(fit.beta[1], fit.beta[2]) * sgn;
         let cov = m * fit.cov_ab * m.transpose() * (sgn * sgn);
-        let w = cov.try_inverse().ok_or_else(|| DisplacementError::Fit("zero residual: cannot weight channels".into()))?;
+        let w = cov.try_inverse().ok_or_else(|| {
+            DisplacementError::Fit("zero residual: cannot weight channels".into())
+        })?;
         info += w;
         info_e += w * e;
         estimates.push((e, w));
@@ -210,10 +227,15 @@ pub fn fit_signal(input: &SignalInput<'_>) -> Result<(SignalFit, SpindleTrack), 
             residual_sd_mm: fit.sigma * factor,
         });
     }
-    let cov = info.try_inverse().ok_or_else(|| DisplacementError::Fit("singular channel combination".into()))?;
+    let cov = info
+        .try_inverse()
+        .ok_or_else(|| DisplacementError::Fit("singular channel combination".into()))?;
     let e = cov * info_e;
     let chi2 = (estimates.len() > 1).then(|| {
-        let s: f64 = estimates.iter().map(|(es, w)| ((es - e).transpose() * w * (es - e))[0]).sum();
+        let s: f64 = estimates
+            .iter()
+            .map(|(es, w)| ((es - e).transpose() * w * (es - e))[0])
+            .sum();
         s / (2.0 * (estimates.len() - 1) as f64)
     });
     let er = rot(e);
