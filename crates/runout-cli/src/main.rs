@@ -19,6 +19,8 @@ struct Cli {
     command: Command,
 }
 
+// parsed once per run: the size of the argument structs does not matter
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).

@@ -411,7 +411,7 @@ fn check_time_grid(t: &Table, col: &Column, times: &[f64]) -> Result<f64, TableE
         });
     }
     let dt = (times[n - 1] - times[0]) / (n - 1) as f64;
-    if !(dt > 0.0) {
+    if dt.is_nan() || dt <= 0.0 {
         return Err(t.cell_error(t.rows[n - 1].0, col, "time does not increase".into()));
     }
     for (i, &ti) in times.iter().enumerate() {

@@ -61,7 +61,7 @@ impl AngleEstimate {
     /// [`ANGLE_SE_LIMIT_RAD`] (or is not finite) becomes undetermined.
     pub fn checked(angle_rad: f64, se_rad: Option<f64>, offset_mm: f64) -> AngleEstimate {
         match se_rad {
-            Some(se) if !(se < ANGLE_SE_LIMIT_RAD) => AngleEstimate::Undetermined {
+            Some(se) if se.is_nan() || se >= ANGLE_SE_LIMIT_RAD => AngleEstimate::Undetermined {
                 reason: format!(
                     "offset {:.4} µm is too small for the noise: σ_λ = {:.1}° exceeds the 10° limit of methods.md §1.5",
                     offset_mm * 1e3,

@@ -502,7 +502,7 @@ fn resolve_mirror(
     notes: &mut Vec<String>,
 ) -> AngleEstimate {
     let cands = [wrap_pi(psi0 + theta), wrap_pi(psi0 - theta)];
-    if let Some(s) = se.filter(|s| !(*s < super::ANGLE_SE_LIMIT_RAD)) {
+    if let Some(s) = se.filter(|s| s.is_nan() || *s >= super::ANGLE_SE_LIMIT_RAD) {
         return AngleEstimate::Undetermined {
             reason: format!(
                 "K = 2: σ_λ = {:.1}° exceeds the 10° limit (θ' = {:.1}° is near 0° or 180°, where dθ/dΔR → ∞, or the offset {:.3} µm is too small for the noise; methods.md §1.5)",

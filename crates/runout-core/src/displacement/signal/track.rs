@@ -121,7 +121,7 @@ pub(crate) fn from_pulse(pulse: &[f64], fs: f64) -> Result<SpindleTrack, Displac
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return Err(DisplacementError::Signal(
             "the pulse channel is constant: no once-per-revolution marks".into(),
         ));
