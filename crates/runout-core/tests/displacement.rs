@@ -476,6 +476,61 @@ fn raw_signal_issue_case() {
     );
 }
 
+/// Noise-free signals (exact data) are fitted exactly, not rejected for a zero residual.
+#[test]
+fn noise_free_signal_is_exact() {
+    let (fs, rpm, n) = (10_000.0, 600.0, 10_000);
+    let s = simulate(n, fs, rpm, 0.004, -2.0, 0.0, 1);
+    let (fit, _) = fit_signal(&input(&s, fs, SpindleReference::Encoder(&s.encoder))).unwrap();
+    assert!((fit.offset_mm - 0.004).abs() < 1e-12);
+    assert!((fit.angle.angle().unwrap() + 2.0).abs() < 1e-9);
+}
+
+/// Off-axis beam (methods.md §1.4) checked against the exact geometry, not the formula: a beam
+/// parallel to the sensor axis but offset by b = 50 µm on a round section R = 0.25 mm hits the
+/// surface at x = c_x + sqrt(R² − (b − c_y)²). Uncorrected, the offset is sec α_b = 1.0206 too large
+/// and the angle off by α_b = 11.54°; corrected, ρ is within 0.1 % and λ within 0.05° (the
+/// neglected terms are O(ρ²/R) and land in the 0th/2nd harmonics; noise-free).
+#[test]
+fn off_axis_beam_signal_matches_exact_geometry() {
+    let (r, b, rho, lam) = (0.25, 0.05, 0.005, 50f64.to_radians());
+    let (fs, rpm, n) = (10_000.0, 600.0, 20_000);
+    let w = rpm / 60.0 * TAU;
+    let (mut d, mut enc) = (vec![], vec![]);
+    for i in 0..n {
+        let phi = w * i as f64 / fs;
+        let (cx, cy) = (rho * (lam + phi).cos(), rho * (lam + phi).sin());
+        d.push(cx + (r * r - (b - cy) * (b - cy)).sqrt());
+        enc.push(phi);
+    }
+    let mk = |beam| SignalInput {
+        sample_rate_hz: fs,
+        channels: vec![SensorChannel {
+            displacement_mm: &d,
+            angle_rad: 0.0,
+            sign: SensorSign::Radial,
+        }],
+        reference: SpindleReference::Encoder(&enc),
+        surface_radius_mm: r,
+        beam,
+        reference_angle_rad: 0.0,
+    };
+    let (raw, _) = fit_signal(&mk(BeamGeometry::ideal())).unwrap();
+    assert!((raw.offset_mm / rho - 1.0 / (1.0 - 0.04f64).sqrt()).abs() < 1e-3);
+    let (fit, _) = fit_signal(&mk(BeamGeometry::new(0.0, b).unwrap())).unwrap();
+    assert!(
+        (fit.offset_mm / rho - 1.0).abs() < 1e-3,
+        "{}",
+        fit.offset_mm
+    );
+    let l = fit.angle.angle().unwrap().to_degrees();
+    assert!((l - 50.0).abs() < 0.05, "{l}");
+    // uncorrected, the sensor direction is taken as β instead of β + α_b: λ comes out α_b too small
+    assert!(
+        (raw.angle.angle().unwrap().to_degrees() - l + 0.2f64.asin().to_degrees()).abs() < 0.05
+    );
+}
+
 /// A toothed profile (K = 3, R = 0.25 mm) read slowly: per-tooth extrema in the angular windows
 /// recover R_i to the sampling resolution (peak curvature c·(Δφ/2)² < 1e-9 mm), and the
 /// identification gives the runout back (1e-6 mm, 0.01°).

@@ -51,7 +51,10 @@ pub(crate) fn fit_harmonics(track: &SpindleTrack, channels: &[&[f64]]) -> Option
                 let rhs = Vector3::new(a[0], a[1], a[2]);
                 let mut beta = inv * rhs;
                 let rss = (a[3] - beta.dot(&rhs)).max(0.0);
-                let s2 = rss / (n - 3.0).max(1.0);
+                // floor at 1e-12 of the signal's rms so that noise-free data still weight the
+                // channels (equally) instead of dividing by a zero variance
+                let floor = 1e-24 * (a[3] / n).max(f64::MIN_POSITIVE);
+                let s2 = (rss / (n - 3.0).max(1.0)).max(floor);
                 beta[0] += sh;
                 HarmonicFit {
                     beta,
