@@ -91,7 +91,8 @@ pub fn run(a: Args) -> Result<()> {
             .to_radians(),
     };
     let (fit, track) = fit_signal(&input).with_context(|| file.clone())?;
-    let revs = per_revolution_runout(&input, &track)?;
+    // seed eq. (5) is a by-product: a record without a complete revolution still gets the fit
+    let revs = per_revolution_runout(&input, &track).unwrap_or_default();
     let mut json = to_json(&file, &table.channels, &fit)?;
     json["beam"] = a.beam.json()?;
     json["per_revolution"] = revs

@@ -28,6 +28,12 @@ pub fn per_revolution_runout(
     track: &SpindleTrack,
 ) -> Result<Vec<RevolutionRunout>, DisplacementError> {
     let factor = input.beam.amplitude_factor(input.surface_radius_mm)?;
+    if track.revolutions.is_empty() {
+        return Err(DisplacementError::Signal(
+            "no complete revolution in the record: the max/min per revolution (seed eq. 5) needs one"
+                .into(),
+        ));
+    }
     Ok(input
         .channels
         .iter()
