@@ -233,9 +233,10 @@ pub(crate) fn estimated(
     rpm_range: (f64, f64),
 ) -> Result<SpindleTrack, DisplacementError> {
     let n = signals[0].len();
-    let mut f = spectral_peak(signals, fs, rpm_range)?;
+    let (mut f, best) = spectral_peak(signals, fs, rpm_range)?;
+    // the drift of the strongest channel alone measures the frequency to far better than needed
     for _ in 0..2 {
-        f += phase_drift_correction(signals, fs, f);
+        f += phase_drift_correction(&signals[best..=best], fs, f);
     }
     let step = TAU * f / fs;
     let revs = (step * n as f64 / TAU).floor() as usize;
@@ -266,12 +267,13 @@ pub(crate) fn estimated(
     })
 }
 
-/// Frequency (Hz) of the strongest spectral line within `rpm_range`.
+/// Frequency (Hz) of the strongest spectral line within `rpm_range`, and the channel in which it
+/// is strongest.
 fn spectral_peak(
     signals: &[&[f64]],
     fs: f64,
     rpm_range: (f64, f64),
-) -> Result<f64, DisplacementError> {
+) -> Result<(f64, usize), DisplacementError> {
     // A 2^18-sample prefix is plenty for the coarse estimate: Jacobsen's interpolation is good to
     // a few hundredths of a bin at any usable SNR, far inside the ±1/T capture range of the
     // phase-drift refinement over the whole record (T ≥ prefix length), and the FFT stays cheap.
@@ -321,7 +323,7 @@ fn spectral_peak(
         0.0
     };
     let corr = (PI / n as f64).tan() / (PI / n as f64);
-    Ok((k as f64 + (d * corr).clamp(-0.5, 0.5)) * df)
+    Ok(((k as f64 + (d * corr).clamp(-0.5, 0.5)) * df, best))
 }
 
 /// Frequency correction (Hz): phase advance of the first harmonic from the first to the second
