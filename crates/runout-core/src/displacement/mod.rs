@@ -15,7 +15,7 @@
 //!
 //! Every estimate carries its standard error (§1.5 error propagation) and the angle is reported
 //! as undetermined, with the reason, when the offset is too small for the noise ([`AngleEstimate`]).
-//! [`consequences`] turns an identified runout into tooth radii, slot width, hole diameter and
+//! [`consequences()`] turns an identified runout into tooth radii, slot width, hole diameter and
 //! per-tooth chip loads (§1.7).
 //!
 //! Angles are radians, lengths mm (µm only in reports).

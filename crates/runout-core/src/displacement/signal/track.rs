@@ -103,7 +103,7 @@ impl SpindleTrack {
         (i >= seg.start).then(|| seg.phase0 + seg.step * (i - seg.start) as f64)
     }
 
-    /// Number of samples visited by [`SpindleTrack::for_each`].
+    /// Number of samples used by the harmonic fit.
     pub fn samples_used(&self) -> usize {
         match &self.encoder {
             Some(e) => e.len(),
