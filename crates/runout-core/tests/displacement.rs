@@ -753,6 +753,34 @@ proptest! {
         prop_assert!(best < 1e-6);
     }
 
+    /// The seed's scan with ρ known recovers λ for K = 3..6 (1° grid + Gauss–Newton to 1e−6 rad;
+    /// tolerance 1e−5 rad).
+    #[test]
+    fn prop_seed_scan(k in 3usize..=6, rho_um in 2.0f64..30.0, lam in -179.0f64..180.0) {
+        let c = micro(k);
+        let t = Runout::new(rho_um * 1e-3, lam.to_radians()).unwrap();
+        let mut o = opts(c.clone());
+        o.method = ToothMethod::SeedScan;
+        o.known_offset_mm = Some(rho_um * 1e-3);
+        let fit = identify_from_teeth(&readings(&t.tooth_radii(&c, 0.0)), &o).unwrap();
+        let dl = runout_core::angle::wrap_pi(fit.angle.angle().unwrap() - lam.to_radians());
+        prop_assert!(dl.abs() < 1e-5);
+    }
+
+    /// Vector fit (§1.6) on noise-free offset + tilt data: E₀ and T exact (1e-12), any planes.
+    #[test]
+    fn prop_vector_fit_exact(e0x in -0.02f64..0.02, e0y in -0.02f64..0.02, tx in -0.002f64..0.002,
+                             ty in -0.002f64..0.002, n in 2usize..8) {
+        let truth = Runout::from_vector([e0x, e0y]).with_tilt_vector([tx, ty]);
+        let pts: Vec<(f64, [f64; 2])> = (0..n).map(|i| {
+            let z = 5.0 + 3.0 * i as f64;
+            (z, truth.vector_at(z))
+        }).collect();
+        let f = vector_at_height(&pts, 0.0).unwrap();
+        prop_assert!((f.offset_at_zero_mm[0] - e0x).abs() < 1e-12 && (f.offset_at_zero_mm[1] - e0y).abs() < 1e-12);
+        prop_assert!((f.tilt[0] - tx).abs() < 1e-12 && (f.tilt[1] - ty).abs() < 1e-12);
+    }
+
     /// OLS on noise-free lines is exact at any evaluation height (1e-12 mm).
     #[test]
     fn prop_ols_exact(r0 in 0.0f64..0.02, slope in -0.002f64..0.002, zc in -5.0f64..5.0, n in 2usize..8) {
