@@ -99,7 +99,10 @@ fn first_harmonic_exact_for_offset_and_tilt_and_bilinear_is_not() {
         let e_n = max_err(&bar, &map, Scheme::FirstHarmonic, 2.0, 28.0);
         assert!(e_n <= 3.3e-9, "C = {c}: max |ε − e·n| = {e_n:e} mm");
         let bil = max_err(&bar, &map, Scheme::Bilinear, 2.0, 28.0);
-        assert!(bil > 1e-4 * (1.0 - (PI / c as f64).cos()) * 10.0, "C = {c}: bilinear {bil:e}");
+        assert!(
+            bil > 1e-4 * (1.0 - (PI / c as f64).cos()) * 10.0,
+            "C = {c}: bilinear {bil:e}"
+        );
     }
 }
 
@@ -169,8 +172,14 @@ fn periodic_wrap_is_continuous() {
             let negative = f.eval(uu, -h).eps;
             let zero = f.eval(uu, 0.0).eps;
             // slope of ε in α is < 0.1 mm/rad here, so 2h of angle moves ε by < 2e-10 mm
-            assert!((below - above).abs() < 1e-9, "{scheme:?} u {uu}: {below} vs {above}");
-            assert!((negative - below).abs() < 1e-12, "{scheme:?}: −h must wrap to 2π − h");
+            assert!(
+                (below - above).abs() < 1e-9,
+                "{scheme:?} u {uu}: {below} vs {above}"
+            );
+            assert!(
+                (negative - below).abs() < 1e-12,
+                "{scheme:?}: −h must wrap to 2π − h"
+            );
             assert!((zero - above).abs() < 1e-9);
             // and the value at the seam is the layer data, not a jump from the other side
             assert!(below.abs() < 0.05);
@@ -189,7 +198,10 @@ fn clamp_and_extrapolate_outside_the_probed_range() {
     assert!(!inside.outside);
     let c0 = clamp.eval(0.0, a);
     assert!(c0.outside);
-    assert!((c0.eps - clamp.eval(5.0, a).eps).abs() < 1e-15, "clamp holds the end layer");
+    assert!(
+        (c0.eps - clamp.eval(5.0, a).eps).abs() < 1e-15,
+        "clamp holds the end layer"
+    );
     // a rigid tilt is linear in u, so extrapolating the end segment is exact
     let x0 = extra.eval(0.0, a);
     assert!(x0.outside && (x0.eps - section_h1(&bar, 0.0, a)).abs() < 1e-9);

@@ -18,7 +18,13 @@ fn good() -> Vec<ProbePoint> {
     let mut v = Vec::new();
     for (i, u) in [5.0, 10.0, 15.0].iter().enumerate() {
         for a in [0.0, 90.0, 180.0, 270.0] {
-            v.push(pt(v.len() + 1, i as i64, *u, a, 3.0 + 0.005 * a.to_radians().cos()));
+            v.push(pt(
+                v.len() + 1,
+                i as i64,
+                *u,
+                a,
+                3.0 + 0.005 * a.to_radians().cos(),
+            ));
         }
     }
     v
@@ -55,7 +61,10 @@ fn fewer_than_three_angles_names_the_rows() {
         ..Default::default()
     };
     let e = err(&v, &opts);
-    assert!(e.contains("layer 1") && e.contains("rows 5..6") && e.contains("2 distinct"), "{e}");
+    assert!(
+        e.contains("layer 1") && e.contains("rows 5..6") && e.contains("2 distinct"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -65,7 +74,10 @@ fn layers_not_increasing_names_the_row() {
         p.u_mm = Some(8.0);
     }
     let e = err(&v, &ProbeOptions::default());
-    assert!(e.contains("row 9") && e.contains("u = 8 mm") && e.contains("10 mm"), "{e}");
+    assert!(
+        e.contains("row 9") && e.contains("u = 8 mm") && e.contains("10 mm"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -96,7 +108,10 @@ fn probe_miss_names_the_row() {
     let mut v = good();
     v[4].touch = Touch::Radius(2.5); // 0.5 mm inside: the probe fell past the bar
     let e = err(&v, &ProbeOptions::default());
-    assert!(e.contains("row 5") && e.contains("probe miss") && e.contains("500.0 µm"), "{e}");
+    assert!(
+        e.contains("row 5") && e.contains("probe miss") && e.contains("500.0 µm"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -107,7 +122,10 @@ fn duplicates_refused_or_averaged() {
     d.touch = Touch::Radius(3.001);
     v.insert(3, d);
     let e = err(&v, &ProbeOptions::default());
-    assert!(e.contains("row 13") && e.contains("row 3") && e.contains("duplicate"), "{e}");
+    assert!(
+        e.contains("row 13") && e.contains("row 3") && e.contains("duplicate"),
+        "{e}"
+    );
     let opts = ProbeOptions {
         duplicates: DuplicatePolicy::Average,
         ..Default::default()
@@ -123,7 +141,10 @@ fn duplicates_refused_or_averaged() {
 fn missing_point_refused_or_skipped() {
     let v: Vec<_> = good().into_iter().filter(|p| p.row != 10).collect();
     let e = err(&v, &ProbeOptions::default());
-    assert!(e.contains("layer 2") && e.contains("90°") && e.contains("missing"), "{e}");
+    assert!(
+        e.contains("layer 2") && e.contains("90°") && e.contains("missing"),
+        "{e}"
+    );
     let opts = ProbeOptions {
         missing: MissingPolicy::Skip,
         ..Default::default()

@@ -43,11 +43,20 @@ fn table_noise_free_rows() {
     // 3 % on rms, 2 % on max.
     for (m, c, rms, max) in [(5, 8, 0.47, 1.04), (3, 4, 1.93, 3.94)] {
         let (r, x) = table_row(m, c, Scheme::Bilinear, &mut || 0.0);
-        assert!((r - rms).abs() <= 0.03 * rms, "M{m}×C{c} bilinear rms {r:.3} vs {rms}");
-        assert!((x - max).abs() <= 0.02 * max, "M{m}×C{c} bilinear max {x:.3} vs {max}");
+        assert!(
+            (r - rms).abs() <= 0.03 * rms,
+            "M{m}×C{c} bilinear rms {r:.3} vs {rms}"
+        );
+        assert!(
+            (x - max).abs() <= 0.02 * max,
+            "M{m}×C{c} bilinear max {x:.3} vs {max}"
+        );
         let (hr, hx) = table_row(m, c, Scheme::FirstHarmonic, &mut || 0.0);
         // exact up to the nm-level ellipse term of the tilted section (tests/grind_interp.rs)
-        assert!(hr < 0.0005 && hx < 0.0005, "M{m}×C{c} harmonic {hr} / {hx} µm");
+        assert!(
+            hr < 0.0005 && hx < 0.0005,
+            "M{m}×C{c} harmonic {hr} / {hx} µm"
+        );
     }
 }
 
@@ -80,7 +89,10 @@ fn table_noise_rows_statistics() {
             "M{m}×C{c}: bilinear mean rms {bil:.3} vs table {seed_rms}"
         );
         // "halves the noise error" (methods.md §5.5)
-        assert!(har <= 0.5 * bil, "M{m}×C{c}: harmonic {har:.3} vs bilinear {bil:.3}");
+        assert!(
+            har <= 0.5 * bil,
+            "M{m}×C{c}: harmonic {har:.3} vs bilinear {bil:.3}"
+        );
     }
 }
 
@@ -99,10 +111,7 @@ fn axis_fit_recovers_offset_and_tilt_with_noise() {
     let ubar = u.iter().sum::<f64>() / u.len() as f64;
     let suu: f64 = u.iter().map(|x| (x - ubar).powi(2)).sum();
     let sc = sigma * (2.0 / 12.0f64).sqrt();
-    let (o_th, t_th) = (
-        sc * (1.0 / 6.0 + ubar * ubar / suu).sqrt(),
-        sc / suu.sqrt(),
-    );
+    let (o_th, t_th) = (sc * (1.0 / 6.0 + ubar * ubar / suu).sqrt(), sc / suu.sqrt());
     for k in 0..2 {
         assert!(
             (ax.offset[k] - bar.offset[k]).abs() <= 4.0 * ose[k],
@@ -113,12 +122,24 @@ fn axis_fit_recovers_offset_and_tilt_with_noise() {
         );
         assert!((ax.tilt[k] - bar.tilt[k]).abs() <= 4.0 * tse[k]);
         // SE estimated from 4 degrees of freedom: within a factor 0.4–1.8 of the truth (95 %)
-        assert!(ose[k] > 0.3 * o_th && ose[k] < 2.0 * o_th, "offset SE {} vs {o_th}", ose[k]);
-        assert!(tse[k] > 0.3 * t_th && tse[k] < 2.0 * t_th, "tilt SE {} vs {t_th}", tse[k]);
+        assert!(
+            ose[k] > 0.3 * o_th && ose[k] < 2.0 * o_th,
+            "offset SE {} vs {o_th}",
+            ose[k]
+        );
+        assert!(
+            tse[k] > 0.3 * t_th && tse[k] < 2.0 * t_th,
+            "tilt SE {} vs {t_th}",
+            tse[k]
+        );
     }
     // residual form error ≈ noise: rms over C points of the residual ≈ σ√((C−3)/C)
     for l in &map.layers {
-        assert!(l.form_rms < 3.0 * sigma && l.form_rms > 0.2 * sigma, "form {}", l.form_rms);
+        assert!(
+            l.form_rms < 3.0 * sigma && l.form_rms > 0.2 * sigma,
+            "form {}",
+            l.form_rms
+        );
         assert!((l.condition - 2f64.sqrt()).abs() < 1e-9);
     }
 }
@@ -134,12 +155,24 @@ fn flat_end_mill_grind_with_and_without_compensation() {
     let edge = EdgeLine::helical_flat(6.0, 4, 30.0, 2.0, 28.0, 400).unwrap();
     let emax = bar.axis_at(28.0)[0].hypot(bar.axis_at(28.0)[1]);
     let f = Interpolator::new(&map, Scheme::FirstHarmonic, RangePolicy::Clamp);
-    let chk = grind_check(&bar, &edge, &compensate(&f, &map.axis, &edge, None).unwrap());
+    let chk = grind_check(
+        &bar,
+        &edge,
+        &compensate(&f, &map.axis, &edge, None).unwrap(),
+    );
     assert!(chk.radius_error_before > 0.9 * emax && chk.radius_error_before <= emax + 1e-6);
-    assert!(chk.radius_error_after < emax * emax / 3.0, "after {}", chk.radius_error_after);
+    assert!(
+        chk.radius_error_after < emax * emax / 3.0,
+        "after {}",
+        chk.radius_error_after
+    );
     assert!(chk.profile_after < emax * emax / 3.0);
     let fb = Interpolator::new(&map, Scheme::Bilinear, RangePolicy::Clamp);
-    let chb = grind_check(&bar, &edge, &compensate(&fb, &map.axis, &edge, None).unwrap());
+    let chb = grind_check(
+        &bar,
+        &edge,
+        &compensate(&fb, &map.axis, &edge, None).unwrap(),
+    );
     // the seed method helps too, within its chord error |e|(1 − cos 22.5°) ≈ 1.5 µm
     assert!(chb.radius_error_after < emax * (1.0 - (std::f64::consts::PI / 8.0).cos()) + 1e-4);
     assert!(chb.radius_error_after > chk.radius_error_after);
@@ -159,24 +192,37 @@ fn ball_end_seed_experiment() {
     let edge = EdgeLine::ball_end(6.0, 2, 30.0, 0.05, 3.0, 300).unwrap();
     let check = |scheme, range| {
         let f = Interpolator::new(&map, scheme, range);
-        grind_check(&bar, &edge, &compensate(&f, &map.axis, &edge, None).unwrap())
+        grind_check(
+            &bar,
+            &edge,
+            &compensate(&f, &map.axis, &edge, None).unwrap(),
+        )
     };
     let ext = check(Scheme::FirstHarmonic, RangePolicy::Extrapolate);
     let clamp = check(Scheme::FirstHarmonic, RangePolicy::Clamp);
     let seed = check(Scheme::Bilinear, RangePolicy::Clamp);
     // before: |e| ≈ 10 µm on the ball, seen as sin θ·e·n along the sphere normal over the
     // angles the two helical edges cover: ≈ 6 µm radius error (the seed had 6.4 µm)
-    assert!(ext.radius_error_before > 0.005 && ext.radius_error_before < 0.008, "{ext:?}");
+    assert!(
+        ext.radius_error_before > 0.005 && ext.radius_error_before < 0.008,
+        "{ext:?}"
+    );
     assert!(ext.profile_before > 0.009, "{ext:?}");
     // outside the probed range, extrapolation follows the tilt; clamping leaves τ·Δu
-    assert!(ext.interpolation_rms < 0.5 * clamp.interpolation_rms, "{ext:?} {clamp:?}");
+    assert!(
+        ext.interpolation_rms < 0.5 * clamp.interpolation_rms,
+        "{ext:?} {clamp:?}"
+    );
     // after, with noise σ√(2/C) = 0.25 µm per layer amplified ≈ 1.8× by extrapolating 4 mm from
     // layers 6 mm apart: max error ≲ 3 × 0.45 µm
     assert!(ext.radius_error_after < 0.0015, "ext {:?}", ext);
     assert!(ext.profile_after < 0.0025, "ext {:?}", ext);
     // beating the seed's reported "< 4 µm / < 3.2 µm" with every scheme here
     for c in [&ext, &clamp, &seed] {
-        assert!(c.radius_error_after < 0.004 && c.profile_after < 0.0032, "{c:?}");
+        assert!(
+            c.radius_error_after < 0.004 && c.profile_after < 0.0032,
+            "{c:?}"
+        );
     }
 }
 

@@ -6,5 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod config;
+pub mod gcode;
+pub mod grind;
 pub mod plot;
 pub mod units;

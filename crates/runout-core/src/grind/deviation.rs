@@ -148,10 +148,7 @@ fn fit_axis(layers: &[LayerDeviation]) -> AxisFit {
     let mut rss = [0.0; 2];
     let ata_inv = (a.transpose() * &a).try_inverse();
     for comp in 0..2 {
-        let b = DVector::from_iterator(
-            m,
-            layers.iter().map(|l| if comp == 0 { l.c } else { l.s }),
-        );
+        let b = DVector::from_iterator(m, layers.iter().map(|l| if comp == 0 { l.c } else { l.s }));
         let x = a
             .clone()
             .svd(true, true)

@@ -35,7 +35,9 @@ pub enum GrindError {
         count: usize,
     },
     /// Fewer than two layers: no interpolation along the bar axis.
-    #[error("probe grid has {0} layer(s); at least 2 layers are needed to interpolate along the bar")]
+    #[error(
+        "probe grid has {0} layer(s); at least 2 layers are needed to interpolate along the bar"
+    )]
     TooFewLayers(usize),
     /// A new layer's axial position does not increase.
     #[error("row {row}: layer {layer} at u = {u_mm} mm does not increase over the previous layer at u = {previous_u_mm} mm (layers must be listed in increasing u)")]

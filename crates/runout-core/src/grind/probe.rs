@@ -228,12 +228,12 @@ fn layer_key(p: &ProbePoint) -> Result<(bool, i64, u64), GrindError> {
     match (p.layer, p.u_mm) {
         (Some(i), _) => Ok((true, i, 0)),
         (None, Some(u)) => Ok((false, 0, u.to_bits())),
-        (None, None) => Err(ParamError::new(
-            format!("row {}", p.row),
-            "a layer index or u_mm",
-            "neither",
-        )
-        .into()),
+        (None, None) => {
+            Err(
+                ParamError::new(format!("row {}", p.row), "a layer index or u_mm", "neither")
+                    .into(),
+            )
+        }
     }
 }
 

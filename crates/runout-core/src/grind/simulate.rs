@@ -44,7 +44,9 @@ pub fn uniform_grid(
     let u = (0..layers)
         .map(|i| u_a + (u_b - u_a) * i as f64 / (layers - 1) as f64)
         .collect();
-    let a = (0..angles).map(|j| TAU * j as f64 / angles as f64).collect();
+    let a = (0..angles)
+        .map(|j| TAU * j as f64 / angles as f64)
+        .collect();
     Ok((u, a))
 }
 
