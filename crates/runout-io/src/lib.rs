@@ -6,7 +6,9 @@
 #![warn(missing_docs)]
 
 pub mod config;
+pub mod export;
 pub mod gcode;
 pub mod grind;
 pub mod plot;
+pub mod recording;
 pub mod units;
