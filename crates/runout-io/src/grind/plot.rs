@@ -117,11 +117,19 @@ pub fn eps_plot(path: &Path, edge: &EdgeLine, comp: &Compensation) -> Result<(),
 /// fitted axis) and the remaining error with compensation.
 pub fn error_plot(path: &Path, edge: &EdgeLine, comp: &Compensation) -> Result<(), PlotError> {
     let mut series = Vec::new();
-    for (f, pts) in per_flute(edge, |k| comp.points[k].before * 1e3) {
-        series.push((format!("before, flute {f}"), pts, RGBColor(214, 39, 40)));
+    for (i, (_, pts)) in per_flute(edge, |k| comp.points[k].before * 1e3)
+        .into_iter()
+        .enumerate()
+    {
+        let name = if i == 0 { "before (all flutes)" } else { "" };
+        series.push((name.to_string(), pts, RGBColor(214, 39, 40)));
     }
-    for (f, pts) in per_flute(edge, |k| comp.points[k].remaining * 1e3) {
-        series.push((format!("after, flute {f}"), pts, RGBColor(31, 119, 180)));
+    for (i, (_, pts)) in per_flute(edge, |k| comp.points[k].remaining * 1e3)
+        .into_iter()
+        .enumerate()
+    {
+        let name = if i == 0 { "after (all flutes)" } else { "" };
+        series.push((name.to_string(), pts, RGBColor(31, 119, 180)));
     }
     let (rb, mb) = comp.before_stats();
     let (ra, ma) = comp.remaining_stats();
@@ -190,7 +198,7 @@ fn draw_lines<DB: DrawingBackend>(
         let s = chart
             .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(1)))
             .map_err(e2s)?;
-        if legend {
+        if legend && !name.is_empty() {
             s.label(name.clone()).legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
             });

@@ -1,0 +1,203 @@
+//! `runout grind compensate` end to end on the shipped example (examples/grind).
+
+use assert_cmd::Command;
+use std::path::PathBuf;
+
+fn runout() -> Command {
+    let mut c = Command::cargo_bin("runout").unwrap();
+    c.env("RUST_BACKTRACE", "0");
+    c
+}
+
+fn ex(name: &str) -> String {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/grind");
+    root.join(name).display().to_string()
+}
+
+fn base() -> Vec<String> {
+    [
+        "grind",
+        "compensate",
+        "--probe",
+        &ex("probe.csv"),
+        "--bar-diameter-mm",
+        "6",
+        "--probe-tip-radius-mm",
+        "1",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect()
+}
+
+/// The example bar: offset (8, −4) µm, tilt (0.3, 0.5) µm/mm, noise 0.3 µm (σ√(2/8) = 0.15 µm
+/// per layer harmonic): the fitted axis is within 0.5 µm and 0.05 µm/mm, and the NC program
+/// changes only in its 27 G1 lines plus the final retract.
+#[test]
+fn compensates_the_example_program() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.nc");
+    let json = dir.path().join("r.json");
+    let path = dir.path().join("path.csv");
+    let mut args = base();
+    args.extend(
+        [
+            "--edge",
+            &ex("edge.csv"),
+            "--nc",
+            &ex("flute.nc"),
+            "--out",
+            out.to_str().unwrap(),
+            "--json",
+            json.to_str().unwrap(),
+            "--path-out",
+            path.to_str().unwrap(),
+            "--plots",
+            dir.path().join("plots").to_str().unwrap(),
+        ]
+        .map(String::from),
+    );
+    runout().args(&args).assert().success();
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(r["schema"], "runout.grind.compensate/1");
+    let off = &r["axis"]["offset_at_u0_um"];
+    assert!(
+        (off[0].as_f64().unwrap() - 8.0).abs() < 0.5
+            && (off[1].as_f64().unwrap() + 4.0).abs() < 0.5
+    );
+    let tilt = &r["axis"]["tilt_um_per_mm"];
+    assert!(
+        (tilt[0].as_f64().unwrap() - 0.3).abs() < 0.05
+            && (tilt[1].as_f64().unwrap() - 0.5).abs() < 0.05
+    );
+    assert_eq!(r["compensation"]["points"], 27);
+    assert!(
+        r["compensation"]["predicted_remaining_max_um"]
+            .as_f64()
+            .unwrap()
+            < 0.6
+    );
+    assert_eq!(r["nc"]["offset_moves"], 27);
+    assert_eq!(r["nc"]["changed_lines"], 28);
+    let input = std::fs::read_to_string(ex("flute.nc")).unwrap();
+    let output = std::fs::read_to_string(&out).unwrap();
+    for (a, b) in input
+        .split_inclusive('\n')
+        .zip(output.split_inclusive('\n'))
+    {
+        if a != b {
+            assert!(
+                a.contains(" G1 ") || a.contains(" G0 Z40."),
+                "unexpected change: {a:?} → {b:?}"
+            );
+            assert!(b.ends_with("\r\n"));
+        }
+    }
+    assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 28);
+    for p in ["deviation_heatmap", "eps_along_edge", "radial_error"] {
+        let svg =
+            std::fs::read_to_string(dir.path().join("plots").join(format!("{p}.svg"))).unwrap();
+        assert!(svg.contains("<svg") && svg.len() > 2000);
+    }
+}
+
+#[test]
+fn generated_edge_text_report_and_json_to_stdout() {
+    let mut args = base();
+    args.extend(["--edge", "flat", "--flutes", "4", "--json", "-"].map(String::from));
+    let o = runout()
+        .args(&args)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let r: serde_json::Value = serde_json::from_slice(&o).unwrap();
+    assert_eq!(r["compensation"]["points"], 800);
+    let mut args = base();
+    args.extend(
+        [
+            "--edge",
+            "ball",
+            "--flutes",
+            "2",
+            "--edge-from-mm",
+            "0.1",
+            "--edge-to-mm",
+            "1.9",
+            "--outside",
+            "extrapolate",
+        ]
+        .map(String::from),
+    );
+    let o = runout()
+        .args(&args)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let text = String::from_utf8(o).unwrap();
+    assert!(
+        text.contains("400 edge points (400 outside the probed range)"),
+        "{text}"
+    );
+    assert!(text.contains("tilt (0.3"), "{text}");
+}
+
+#[test]
+fn refuses_to_overwrite_inputs_and_names_bad_rows() {
+    let mut args = base();
+    args.extend(
+        [
+            "--edge",
+            &ex("edge.csv"),
+            "--nc",
+            &ex("flute.nc"),
+            "--out",
+            &ex("flute.nc"),
+        ]
+        .map(String::from),
+    );
+    runout()
+        .args(&args)
+        .assert()
+        .failure()
+        .stderr(predicates::str::contains("refusing to write"));
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("probe.csv");
+    let text = std::fs::read_to_string(ex("probe.csv")).unwrap();
+    // line 9 (layer 0, 225°): the probe missed the bar
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    lines[8] = "0,2,225,-1.0,-1.0,2.0".into();
+    std::fs::write(&bad, lines.join("\n")).unwrap();
+    let mut args = base();
+    args[3] = bad.display().to_string();
+    args.extend(["--edge", "flat"].map(String::from));
+    runout()
+        .args(&args)
+        .assert()
+        .code(1)
+        .stderr(predicates::str::contains("row 9").and(predicates::str::contains("probe miss")));
+    // index mapping with a count mismatch is explained
+    let mut args = base();
+    args.extend(
+        [
+            "--edge",
+            "flat",
+            "--nc",
+            &ex("flute.nc"),
+            "--out",
+            dir.path().join("o.nc").to_str().unwrap(),
+        ]
+        .map(String::from),
+    );
+    runout()
+        .args(&args)
+        .assert()
+        .failure()
+        .stderr(predicates::str::contains("--nc-map xyz"));
+}
+
+use predicates::prelude::PredicateBooleanExt;
