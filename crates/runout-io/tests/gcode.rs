@@ -1,5 +1,6 @@
 //! G-code lexer / rewriter: byte-identical round trip, only coordinate words of motion lines
 //! change, cross-check with an independent parser (Python `pygcode`), errors with positions.
+#![allow(clippy::needless_range_loop)] // axis loops index several parallel arrays
 
 use proptest::prelude::*;
 use runout_io::gcode::{lex, NcProgram, RewriteOptions};

@@ -14,8 +14,8 @@ fn grid_text(rows: &[(i64, f64, f64, f64)]) -> String {
 fn rows() -> Vec<(i64, f64, f64, f64)> {
     let mut v = Vec::new();
     for (i, u) in [4.0, 12.0, 20.0].iter().enumerate() {
-        for a in [0.0, 90.0, 180.0, 270.0] {
-            let r = 3.0 + 0.006 * (a as f64).to_radians().cos() + 0.0001 * u;
+        for a in [0.0f64, 90.0, 180.0, 270.0] {
+            let r = 3.0 + 0.006 * a.to_radians().cos() + 0.0001 * u;
             v.push((i as i64, *u, a, r));
         }
     }

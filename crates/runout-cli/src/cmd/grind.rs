@@ -203,10 +203,9 @@ fn scheme(a: &CompensateArgs) -> Result<(Scheme, RangePolicy)> {
 }
 
 /// The edge and, for CSV edges, the wheel positions and the CSV path.
-fn edge(
-    a: &CompensateArgs,
-    grid: &ProbeGrid,
-) -> Result<(EdgeLine, Option<Vec<[f64; 3]>>, Option<PathBuf>)> {
+type EdgeInput = (EdgeLine, Option<Vec<[f64; 3]>>, Option<PathBuf>);
+
+fn edge(a: &CompensateArgs, grid: &ProbeGrid) -> Result<EdgeInput> {
     let kind = a.edge.as_str();
     if kind != "flat" && kind != "ball" {
         let p = PathBuf::from(kind);

@@ -34,7 +34,7 @@ pub fn uniform_grid(
     if angles < 3 {
         return Err(ParamError::new("angles", "an integer >= 3", angles));
     }
-    if !(u_b > u_a) {
+    if u_b.is_nan() || u_a.is_nan() || u_b <= u_a {
         return Err(ParamError::new(
             "u_end_mm",
             format!("a value above u_start_mm = {u_a}"),

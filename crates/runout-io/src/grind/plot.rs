@@ -102,12 +102,11 @@ fn draw_heat<DB: DrawingBackend>(
 
 /// ε (µm) along the edge against u (mm), one line per flute (methods.md §5.3).
 pub fn eps_plot(path: &Path, edge: &EdgeLine, comp: &Compensation) -> Result<(), PlotError> {
-    let series: Vec<(String, Vec<(f64, f64)>, RGBColor)> =
-        per_flute(edge, |k| comp.points[k].eps * 1e3)
-            .into_iter()
-            .enumerate()
-            .map(|(i, (f, pts))| (format!("flute {f}"), pts, colour(i)))
-            .collect();
+    let series: Vec<Series> = per_flute(edge, |k| comp.points[k].eps * 1e3)
+        .into_iter()
+        .enumerate()
+        .map(|(i, (f, pts))| (format!("flute {f}"), pts, colour(i)))
+        .collect();
     render_plot!(path, (900, 520), |root: &DrawingArea<_, Shift>| {
         draw_lines(root, &series, "deviation ε along the edge", "ε (µm)")
     })
