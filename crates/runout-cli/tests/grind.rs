@@ -200,4 +200,46 @@ fn refuses_to_overwrite_inputs_and_names_bad_rows() {
         .stderr(predicates::str::contains("--nc-map xyz"));
 }
 
+/// The example program's X Y Z are the edge points themselves, so `--nc-map xyz` (ε evaluated at
+/// each move's own position) must give the same program as `--nc-map index` with edge.csv.
+#[test]
+fn xyz_mapping_equals_index_mapping_on_the_example() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.nc"), dir.path().join("b.nc"));
+    let mut args = base();
+    args.extend(
+        [
+            "--edge",
+            &ex("edge.csv"),
+            "--nc",
+            &ex("flute.nc"),
+            "--out",
+            a.to_str().unwrap(),
+        ]
+        .map(String::from),
+    );
+    runout().args(&args).assert().success();
+    let mut args = base();
+    args.extend(
+        [
+            "--edge",
+            "flat",
+            "--nc-map",
+            "xyz",
+            "--nc",
+            &ex("flute.nc"),
+            "--out",
+            b.to_str().unwrap(),
+        ]
+        .map(String::from),
+    );
+    runout().args(&args).assert().success();
+    let (ta, tb) = (
+        std::fs::read_to_string(&a).unwrap(),
+        std::fs::read_to_string(&b).unwrap(),
+    );
+    assert_eq!(ta, tb);
+    assert_ne!(ta, std::fs::read_to_string(ex("flute.nc")).unwrap());
+}
+
 use predicates::prelude::PredicateBooleanExt;

@@ -87,7 +87,7 @@ pub struct CompensateArgs {
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// NC block ↔ offset mapping: `index` (k-th move ↔ k-th edge point) or `xyz` (the move's
-    /// X Y Z is a bar-frame point: u = Z, α = atan2(Y, X)).
+    /// X Y Z is a bar-frame point: u = Z, α = atan2(Y, X); rotary axes must stay constant).
     #[arg(long, default_value = "index")]
     pub nc_map: String,
     /// Which NC moves are offset: feed (G1 only) | all (G0 and G1).
@@ -211,12 +211,23 @@ fn edge(a: &CompensateArgs, grid: &ProbeGrid) -> Result<EdgeInput> {
         let p = PathBuf::from(kind);
         let text = read(&p, "edge")?;
         let t = runout_io::grind::read_edge_csv(&text, kind)?;
-        let e = EdgeLine::from_points(&t.points, t.normals.as_deref()).map_err(|e| {
-            anyhow::anyhow!(
-                "{kind}: {e} (point k is on data row k + 1: line {:?})",
-                t.lines.first()
-            )
-        })?;
+        for (k, p) in t.points.iter().enumerate() {
+            let on_axis = p[0].hypot(p[1]) == 0.0;
+            let zero_normal = t.normals.as_ref().is_some_and(|n| n[k] == [0.0; 3]);
+            if zero_normal || (on_axis && t.normals.is_none()) {
+                bail!(
+                    "{kind}, line {}: {} (its offset direction is undefined)",
+                    t.lines[k],
+                    if zero_normal {
+                        "normal (0, 0, 0)"
+                    } else {
+                        "point on the bar axis without a normal"
+                    }
+                );
+            }
+        }
+        let e = EdgeLine::from_points(&t.points, t.normals.as_deref())
+            .with_context(|| format!("edge {kind}"))?;
         return Ok((e, t.wheel, Some(p)));
     }
     let bar_d = 2.0 * grid.generatrix.radius(grid.u_range().0);
@@ -243,7 +254,8 @@ fn compensate_cmd(a: CompensateArgs) -> Result<()> {
     let probe_text = read(&a.probe, "probe table")?;
     let pname = a.probe.display().to_string();
     let points = runout_io::grind::read_probe_csv(&probe_text, &pname)?;
-    let grid = ProbeGrid::assemble(&points, generatrix(&a)?, &options(&a)?)
+    let opts = options(&a)?;
+    let grid = ProbeGrid::assemble(&points, generatrix(&a)?, &opts)
         .with_context(|| format!("{pname} (rows are file line numbers)"))?;
     let map = DeviationMap::new(&grid);
     let (sch, range) = scheme(&a)?;
@@ -279,7 +291,7 @@ fn compensate_cmd(a: CompensateArgs) -> Result<()> {
     if let Some(dir) = &a.plots {
         plots(dir, &a.plot_format, &map, &edge, &comp)?;
     }
-    let report = report_json(&a, &grid, &map, &comp, nc_summary.as_ref());
+    let report = report_json(&a, &opts, &grid, &map, &comp, nc_summary.as_ref());
     if let Some(j) = &a.json {
         output::write_text(j, &(serde_json::to_string_pretty(&report)? + "\n"))?;
     }
@@ -340,6 +352,18 @@ fn rewrite_nc(
             }
         }
         "xyz" => {
+            if let Some(&f) = eligible.first() {
+                for &b in &eligible {
+                    if blocks[b].target[3..] != blocks[f].target[3..] {
+                        bail!(
+                            "{}: line {}: rotary axes (A B C) change between offset moves, so X Y Z are not \
+                             bar-frame points; --nc-map xyz needs a program in the bar frame (use --nc-map index)",
+                            nc.display(),
+                            blocks[b].line
+                        );
+                    }
+                }
+            }
             for &b in &eligible {
                 let t = blocks[b].target;
                 let (Some(x), Some(y), Some(z)) = (t[0], t[1], t[2]) else {
@@ -413,6 +437,7 @@ fn um2(v: [f64; 2]) -> [f64; 2] {
 /// JSON report, schema `runout.grind.compensate/1`.
 fn report_json(
     a: &CompensateArgs,
+    opts: &ProbeOptions,
     grid: &ProbeGrid,
     map: &DeviationMap,
     comp: &Compensation,
@@ -436,8 +461,10 @@ fn report_json(
             "edge": a.edge,
             "scheme": format!("{:?}", comp.scheme),
             "outside_probed_range": format!("{:?}", comp.range),
-            "probe_tip_radius_mm": a.probe_tip_radius_mm,
-            "miss_limit_um": a.miss_limit_um,
+            "probe_tip_radius_mm": opts.tip_radius_mm,
+            "miss_limit_um": opts.miss_limit_mm * 1e3,
+            "duplicates": format!("{:?}", opts.duplicates),
+            "missing": format!("{:?}", opts.missing),
         },
         "frame": "bar frame: u from the tool tip along the work-head axis; x, y right-handed, α counter-clockwise about +u (= −spindle-frame angle, conventions.md)",
         "grid": {
@@ -503,16 +530,16 @@ fn print_text(grid: &ProbeGrid, map: &DeviationMap, comp: &Compensation, nc: Opt
     for n in &grid.notes {
         println!("note: {n}");
     }
-    let se = |v: Option<[f64; 2]>| {
+    let se = |v: Option<[f64; 2]>, d: usize| {
         v.map_or("n/a".to_string(), |s| {
-            format!("± ({:.2}, {:.2})", s[0] * 1e3, s[1] * 1e3)
+            format!("± ({:.d$}, {:.d$})", s[0] * 1e3, s[1] * 1e3)
         })
     };
     println!(
         "bar axis at u = 0: offset ({:.2}, {:.2}) µm {} = {:.2} µm at {:.1}° (runout angle λ {:.1}°)",
         ax.offset[0] * 1e3,
         ax.offset[1] * 1e3,
-        se(ax.offset_se),
+        se(ax.offset_se, 2),
         o_mag,
         o_ang,
         lambda
@@ -521,7 +548,7 @@ fn print_text(grid: &ProbeGrid, map: &DeviationMap, comp: &Compensation, nc: Opt
         "tilt ({:.3}, {:.3}) µm/mm {}; layer residual rms {:.3} µm",
         ax.tilt[0] * 1e3,
         ax.tilt[1] * 1e3,
-        se(ax.tilt_se),
+        se(ax.tilt_se, 3),
         ax.residual_rms * 1e3
     );
     println!("layer  u (mm)   max|δ| (µm)  first harmonic (µm)   form rms/max (µm)");
