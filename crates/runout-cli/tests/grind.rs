@@ -242,4 +242,64 @@ fn xyz_mapping_equals_index_mapping_on_the_example() {
     assert_ne!(ta, std::fs::read_to_string(ex("flute.nc")).unwrap());
 }
 
+/// `runout grind check` reproduces the noise-free rows of methods.md §5.5 with the documented
+/// setup (one edge at phase 18°, edge and layers on u = 2..28 mm): seed method 0.47 / 1.04 µm
+/// (M5×C8) and 1.93 / 3.94 µm (M3×C4), first harmonic 0 / 0; tolerance 3 % rms, 2 % max as in
+/// runout-core's tests/grind_sim.rs.
+#[test]
+fn check_reproduces_the_methods_table() {
+    for (m, c, rms, max) in [("5", "8", 0.47, 1.04), ("3", "4", 1.93, 3.94)] {
+        let o = runout()
+            .args([
+                "grind",
+                "check",
+                "--layers",
+                m,
+                "--angles",
+                c,
+                "--flutes",
+                "1",
+                "--edge-from-mm",
+                "2",
+                "--edge-phase-deg",
+                "18",
+                "--points-per-flute",
+                "2001",
+                "--json",
+                "-",
+            ])
+            .assert()
+            .success()
+            .get_output()
+            .stdout
+            .clone();
+        let r: serde_json::Value = serde_json::from_slice(&o).unwrap();
+        assert_eq!(r["schema"], "runout.grind.check/1");
+        let b = &r["bilinear"];
+        let (br, bx) = (
+            b["interpolation_rms_um"].as_f64().unwrap(),
+            b["interpolation_max_um"].as_f64().unwrap(),
+        );
+        assert!(
+            (br - rms).abs() <= 0.03 * rms && (bx - max).abs() <= 0.02 * max,
+            "{b}"
+        );
+        assert!(
+            r["first_harmonic"]["interpolation_max_um"]
+                .as_f64()
+                .unwrap()
+                < 1e-3
+        );
+        // uncompensated: max |e·n| ≈ |e(28)| = 19.2 µm along the edge's angles
+        assert!(r["uncompensated"]["radius_error_um"].as_f64().unwrap() > 10.0);
+    }
+    runout()
+        .args(["grind", "check", "--offset-um", "8"])
+        .assert()
+        .failure()
+        .stderr(predicates::str::contains(
+            "--offset-um: expected two comma-separated values",
+        ));
+}
+
 use predicates::prelude::PredicateBooleanExt;

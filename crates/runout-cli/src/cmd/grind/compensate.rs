@@ -2,28 +2,15 @@
 //! methods.md §5). Reads the probe table, builds the deviation map and fitted bar axis,
 //! interpolates ε onto the edge, offsets the wheel path (CSV) and/or rewrites an NC program.
 
+use super::{edge, q, read, EdgeFlags};
 use crate::output;
 use anyhow::{bail, Context, Result};
 use runout_core::angle::wrap_deg180;
 use runout_core::grind::*;
 use runout_io::gcode::{NcProgram, RewriteOptions};
-use runout_io::units::{parse_quantity, Quantity};
+use runout_io::units::Quantity;
 use serde_json::json;
 use std::path::{Path, PathBuf};
-
-/// `runout grind …`
-#[derive(clap::Args, Debug)]
-pub struct Args {
-    #[command(subcommand)]
-    pub command: GrindCommand,
-}
-
-/// Grinding subcommands.
-#[derive(clap::Subcommand, Debug)]
-pub enum GrindCommand {
-    /// Compensate the bar clamping error on an edge / wheel path and optionally an NC program.
-    Compensate(Box<CompensateArgs>),
-}
 
 /// Flags of `runout grind compensate`.
 #[derive(clap::Args, Debug)]
@@ -55,31 +42,8 @@ pub struct CompensateArgs {
     /// Outside the probed u range: clamp | extrapolate.
     #[arg(long, default_value = "clamp")]
     pub outside: String,
-    /// Edge: `flat` (helical peripheral edge), `ball` (ball end), or a CSV file with
-    /// `x_mm,y_mm,z_mm[,nx,ny,nz][,wx_mm,wy_mm,wz_mm]` (bar frame).
-    #[arg(long)]
-    pub edge: String,
-    /// Edge diameter (mm) for flat/ball edges (default: the bar diameter).
-    #[arg(long, allow_hyphen_values = true)]
-    pub edge_diameter_mm: Option<String>,
-    /// Number of flutes K.
-    #[arg(long, default_value = "4")]
-    pub flutes: usize,
-    /// Helix angle (deg).
-    #[arg(long, allow_hyphen_values = true, default_value = "30")]
-    pub helix_deg: String,
-    /// Edge start, axial position from the tool tip (mm).
-    #[arg(long, allow_hyphen_values = true, default_value = "0")]
-    pub edge_from_mm: String,
-    /// Edge end (mm).
-    #[arg(long, allow_hyphen_values = true)]
-    pub edge_to_mm: Option<String>,
-    /// Points per flute (count).
-    #[arg(long, default_value = "200")]
-    pub points_per_flute: usize,
-    /// Angular position of flute 0 at the tip in the bar frame (deg).
-    #[arg(long, allow_hyphen_values = true, default_value = "0")]
-    pub edge_phase_deg: String,
+    #[command(flatten)]
+    pub edge: EdgeFlags,
     /// Input NC program (ISO G-code) whose linear moves are offset.
     #[arg(long)]
     pub nc: Option<PathBuf>,
@@ -108,20 +72,6 @@ pub struct CompensateArgs {
     /// Plot format: svg | png.
     #[arg(long, default_value = "svg")]
     pub plot_format: String,
-}
-
-pub fn run(a: Args) -> Result<()> {
-    match a.command {
-        GrindCommand::Compensate(c) => compensate_cmd(*c),
-    }
-}
-
-fn q(flag: &str, text: &str, quantity: Quantity) -> Result<f64> {
-    parse_quantity(text, quantity).with_context(|| format!("--{flag}"))
-}
-
-fn read(path: &Path, what: &str) -> Result<String> {
-    std::fs::read_to_string(path).with_context(|| format!("reading {what} {}", path.display()))
 }
 
 fn generatrix(a: &CompensateArgs) -> Result<Generatrix> {
@@ -202,55 +152,7 @@ fn scheme(a: &CompensateArgs) -> Result<(Scheme, RangePolicy)> {
     Ok((s, r))
 }
 
-/// The edge and, for CSV edges, the wheel positions and the CSV path.
-type EdgeInput = (EdgeLine, Option<Vec<[f64; 3]>>, Option<PathBuf>);
-
-fn edge(a: &CompensateArgs, grid: &ProbeGrid) -> Result<EdgeInput> {
-    let kind = a.edge.as_str();
-    if kind != "flat" && kind != "ball" {
-        let p = PathBuf::from(kind);
-        let text = read(&p, "edge")?;
-        let t = runout_io::grind::read_edge_csv(&text, kind)?;
-        for (k, p) in t.points.iter().enumerate() {
-            let on_axis = p[0].hypot(p[1]) == 0.0;
-            let zero_normal = t.normals.as_ref().is_some_and(|n| n[k] == [0.0; 3]);
-            if zero_normal || (on_axis && t.normals.is_none()) {
-                bail!(
-                    "{kind}, line {}: {} (its offset direction is undefined)",
-                    t.lines[k],
-                    if zero_normal {
-                        "normal (0, 0, 0)"
-                    } else {
-                        "point on the bar axis without a normal"
-                    }
-                );
-            }
-        }
-        let e = EdgeLine::from_points(&t.points, t.normals.as_deref())
-            .with_context(|| format!("edge {kind}"))?;
-        return Ok((e, t.wheel, Some(p)));
-    }
-    let bar_d = 2.0 * grid.generatrix.radius(grid.u_range().0);
-    let d = match &a.edge_diameter_mm {
-        Some(d) => q("edge-diameter-mm", d, Quantity::LengthMm)?,
-        None => bar_d,
-    };
-    let helix = q("helix-deg", &a.helix_deg, Quantity::AngleDeg)?;
-    let z0 = q("edge-from-mm", &a.edge_from_mm, Quantity::LengthMm)?;
-    let z1 = match &a.edge_to_mm {
-        Some(z) => q("edge-to-mm", z, Quantity::LengthMm)?,
-        None => grid.u_range().1,
-    };
-    let phase = q("edge-phase-deg", &a.edge_phase_deg, Quantity::AngleDeg)?.to_radians();
-    let e = if kind == "flat" {
-        EdgeLine::helical_flat(d, a.flutes, helix, z0, z1, a.points_per_flute)?
-    } else {
-        EdgeLine::ball_end(d, a.flutes, helix, z0, z1, a.points_per_flute)?
-    };
-    Ok((e.rotated(phase), None, None))
-}
-
-fn compensate_cmd(a: CompensateArgs) -> Result<()> {
+pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
     let probe_text = read(&a.probe, "probe table")?;
     let pname = a.probe.display().to_string();
     let points = runout_io::grind::read_probe_csv(&probe_text, &pname)?;
@@ -260,7 +162,8 @@ fn compensate_cmd(a: CompensateArgs) -> Result<()> {
     let map = DeviationMap::new(&grid);
     let (sch, range) = scheme(&a)?;
     let interp = Interpolator::new(&map, sch, range);
-    let (edge, wheel, edge_path) = edge(&a, &grid)?;
+    let bar_d = 2.0 * grid.generatrix.radius(grid.u_range().0);
+    let (edge, wheel, edge_path) = edge(&a.edge, bar_d, grid.u_range().1)?;
 
     let mut inputs: Vec<&Path> = vec![a.probe.as_path()];
     inputs.extend(a.generatrix.as_deref());
@@ -458,7 +361,7 @@ fn report_json(
         "schema": "runout.grind.compensate/1",
         "inputs": {
             "probe": a.probe.display().to_string(),
-            "edge": a.edge,
+            "edge": a.edge.kind,
             "scheme": format!("{:?}", comp.scheme),
             "outside_probed_range": format!("{:?}", comp.range),
             "probe_tip_radius_mm": opts.tip_radius_mm,
