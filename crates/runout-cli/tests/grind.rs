@@ -302,4 +302,53 @@ fn check_reproduces_the_methods_table() {
         ));
 }
 
+/// Radius-only probe table, offset 10 µm at 30° in the probe's angle sense: read as ccw the bar
+/// offset is at +30°, read as cw at −30° (runout angle λ = −α: −30° and +30°).
+#[test]
+fn probe_angle_sense() {
+    let dir = tempfile::tempdir().unwrap();
+    let probe = dir.path().join("p.csv");
+    let mut t = String::from("layer,u_mm,angle_deg,radius_mm\n");
+    for (i, u) in [5.0, 15.0].iter().enumerate() {
+        for j in 0..6 {
+            let a = 60.0 * j as f64;
+            t += &format!(
+                "{i},{u},{a},{:.7}\n",
+                3.0 + 0.01 * (a - 30.0f64).to_radians().cos()
+            );
+        }
+    }
+    std::fs::write(&probe, t).unwrap();
+    for (sense, want) in [("ccw", 30.0), ("cw", -30.0)] {
+        let o = runout()
+            .args([
+                "grind",
+                "compensate",
+                "--probe",
+                probe.to_str().unwrap(),
+                "--bar-diameter-mm",
+                "6",
+                "--probe-angle-sense",
+                sense,
+                "--json",
+                "-",
+            ])
+            .assert()
+            .success()
+            .get_output()
+            .stdout
+            .clone();
+        let r: serde_json::Value = serde_json::from_slice(&o).unwrap();
+        let ax = &r["axis"];
+        assert!(
+            (ax["offset_angle_bar_deg"].as_f64().unwrap() - want).abs() < 1e-3,
+            "{ax}"
+        );
+        assert!((ax["runout_angle_deg"].as_f64().unwrap() + want).abs() < 1e-3);
+        assert!((ax["offset_um"].as_f64().unwrap() - 10.0).abs() < 1e-3);
+        // two layers: no standard errors
+        assert!(ax["offset_se_um"].is_null());
+    }
+}
+
 use predicates::prelude::PredicateBooleanExt;

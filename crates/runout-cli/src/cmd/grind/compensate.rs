@@ -18,6 +18,11 @@ pub struct CompensateArgs {
     /// Probe table (CSV): `layer` and/or `u_mm`, `angle_deg`, and `radius_mm` or `x_mm,y_mm[,z_mm]`.
     #[arg(long)]
     pub probe: PathBuf,
+    /// Sense of the probe table's `angle_deg`, seen from the shank looking at the tip: ccw (the
+    /// bar frame: right-handed about the axis towards the shank) | cw (negated on reading; only
+    /// `angle_deg` is affected, x/y columns are taken as bar-frame coordinates).
+    #[arg(long, default_value = "ccw")]
+    pub probe_angle_sense: String,
     /// Nominal bar diameter (mm) for a cylindrical generatrix.
     #[arg(long, allow_hyphen_values = true)]
     pub bar_diameter_mm: Option<String>,
@@ -155,7 +160,12 @@ fn scheme(a: &CompensateArgs) -> Result<(Scheme, RangePolicy)> {
 pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
     let probe_text = read(&a.probe, "probe table")?;
     let pname = a.probe.display().to_string();
-    let points = runout_io::grind::read_probe_csv(&probe_text, &pname)?;
+    let mut points = runout_io::grind::read_probe_csv(&probe_text, &pname)?;
+    match a.probe_angle_sense.as_str() {
+        "ccw" => {}
+        "cw" => points.iter_mut().for_each(|p| p.angle = -p.angle),
+        o => bail!("--probe-angle-sense: expected ccw | cw, got `{o}`"),
+    }
     let opts = options(&a)?;
     let grid = ProbeGrid::assemble(&points, generatrix(&a)?, &opts)
         .with_context(|| format!("{pname} (rows are file line numbers)"))?;
@@ -364,6 +374,7 @@ fn report_json(
             "edge": a.edge.kind,
             "scheme": format!("{:?}", comp.scheme),
             "outside_probed_range": format!("{:?}", comp.range),
+            "probe_angle_sense": a.probe_angle_sense,
             "probe_tip_radius_mm": opts.tip_radius_mm,
             "miss_limit_um": opts.miss_limit_mm * 1e3,
             "duplicates": format!("{:?}", opts.duplicates),
