@@ -19,15 +19,16 @@ struct Cli {
     command: Command,
 }
 
-// parsed once per run: the size of the argument structs does not matter
-#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand, Debug)]
+#[allow(clippy::large_enum_variant)] // argument structs, parsed once
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
     Simulate(cmd::simulate::Args),
     /// Runout identified in position from displacement readings: per-tooth readings, runout at
     /// several heights, or a raw signal (methods.md §1).
     Displacement(cmd::displacement::Args),
+    /// Tool grinding: compensate the bar clamping error (probe grid → wheel path / NC program).
+    Grind(cmd::grind::Args),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +36,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Displacement(a) => cmd::displacement::run(a),
+        Command::Grind(a) => cmd::grind::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

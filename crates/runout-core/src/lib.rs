@@ -26,6 +26,7 @@ pub mod cutter;
 pub mod displacement;
 pub mod error;
 pub mod force;
+pub mod grind;
 pub mod runout;
 
 pub use chip::{ArcChip, ChipAtHeight, ChipThickness};

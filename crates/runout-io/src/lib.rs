@@ -9,6 +9,8 @@ pub mod config;
 pub mod displacement;
 pub mod displacement_plot;
 pub mod export;
+pub mod gcode;
+pub mod grind;
 pub mod plot;
 pub mod recording;
 pub mod units;
