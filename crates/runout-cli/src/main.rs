@@ -19,12 +19,16 @@ struct Cli {
     command: Command,
 }
 
-// Parsed once per run: the size difference between subcommand argument structs is irrelevant.
-#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand, Debug)]
+#[allow(clippy::large_enum_variant)] // argument structs, parsed once
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
     Simulate(cmd::simulate::Args),
+    /// Runout identified in position from displacement readings: per-tooth readings, runout at
+    /// several heights, or a raw signal (methods.md §1).
+    Displacement(cmd::displacement::Args),
+    /// Tool grinding: compensate the bar clamping error (probe grid → wheel path / NC program).
+    Grind(cmd::grind::Args),
     /// Cutting force and runout from two-point shank deflection (capacitive sensors).
     Shank(cmd::shank::Args),
 }
@@ -33,6 +37,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
+        Command::Displacement(a) => cmd::displacement::run(a),
+        Command::Grind(a) => cmd::grind::run(a),
         Command::Shank(a) => cmd::shank::run(a),
     };
     match result {

@@ -6,7 +6,11 @@
 #![warn(missing_docs)]
 
 pub mod config;
+pub mod displacement;
+pub mod displacement_plot;
 pub mod export;
+pub mod gcode;
+pub mod grind;
 pub mod lineplot;
 pub mod plot;
 pub mod recording;

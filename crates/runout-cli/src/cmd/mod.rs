@@ -1,4 +1,6 @@
 //! One module per subcommand.
 
+pub mod displacement;
+pub mod grind;
 pub mod shank;
 pub mod simulate;
