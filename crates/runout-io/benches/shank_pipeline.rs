@@ -8,11 +8,16 @@ use runout_core::shank::{
     analyse, OutputBlock, PairAxis, Reconstructor, SensorPair, ShankBeam, ShankSetup, Survey,
     SyntheticShank,
 };
-use runout_io::recording::{Chunk, CsvWriter, ReadOptions, RecordingReader};
+use runout_io::recording::{
+    BinaryLayout, BinaryWriter, Chunk, CsvWriter, ReadOptions, RecordingReader,
+};
 use std::f64::consts::TAU;
 use std::hint::black_box;
 
 const FS: f64 = 100_000.0;
+
+/// Where output rows go (CSV or binary writer).
+type RowSink = Box<dyn FnMut(&[f64])>;
 
 fn generate() -> Vec<u8> {
     // a 3-tooth-like force: half-sine pulses per tooth period
@@ -87,7 +92,7 @@ fn to_mm(c: &mut Chunk) {
         .for_each(|v| v.iter_mut().for_each(|x| *x *= 1e-3));
 }
 
-fn pipeline(bytes: &[u8]) -> f64 {
+fn pipeline(bytes: &[u8], csv: bool) -> f64 {
     let opts = ReadOptions::new();
     let mut survey = Survey::new(&setup()).unwrap();
     let mut r = RecordingReader::from_bytes("bench.csv", bytes, &opts).unwrap();
@@ -101,10 +106,23 @@ fn pipeline(bytes: &[u8]) -> f64 {
     let an = analyse(&res).unwrap();
     let mut rec = Reconstructor::new(&res, &an).unwrap();
     // the CLI's fixed decimals: time 1e-7 s, forces 0.1 mN, deflections 0.01 nm
-    let mut w = CsvWriter::new(std::io::sink(), &rec.column_names())
-        .unwrap()
-        .with_decimals(&[7, 4, 4, 5, 5, 5, 5, 0])
+    let names = rec.column_names();
+    let mut w: RowSink = if csv {
+        let mut w = CsvWriter::new(std::io::sink(), &names)
+            .unwrap()
+            .with_decimals(&[7, 4, 4, 5, 5, 5, 5, 0])
+            .unwrap();
+        Box::new(move |r: &[f64]| w.write_row(r).unwrap())
+    } else {
+        let mut w = BinaryWriter::new(
+            std::io::sink(),
+            &names,
+            BinaryLayout::F32,
+            serde_json::Value::Null,
+        )
         .unwrap();
+        Box::new(move |r: &[f64]| w.write_row(r).unwrap())
+    };
     let mut out = OutputBlock::default();
     let mut r = RecordingReader::from_bytes("bench.csv", bytes, &opts).unwrap();
     let mut acc = 0.0;
@@ -124,7 +142,7 @@ fn pipeline(bytes: &[u8]) -> f64 {
                 out.delta_ii_um[1][i],
                 f64::from(u8::from(out.saturated[i])),
             ];
-            w.write_row(&row).unwrap();
+            w(&row);
         }
         acc += out.force_n[1].iter().sum::<f64>();
     }
@@ -150,7 +168,10 @@ fn bench(c: &mut Criterion) {
         b.iter(|| black_box(parse_only(black_box(&bytes))))
     });
     g.bench_function("force_pipeline_two_passes_with_csv_output", |b| {
-        b.iter(|| black_box(pipeline(black_box(&bytes))))
+        b.iter(|| black_box(pipeline(black_box(&bytes), true)))
+    });
+    g.bench_function("force_pipeline_two_passes_with_f32_binary_output", |b| {
+        b.iter(|| black_box(pipeline(black_box(&bytes), false)))
     });
     g.finish();
 }
