@@ -6,8 +6,19 @@
 //! this interface, so every model can drive it.
 
 mod arc;
+pub mod closed_form;
+pub mod exact;
+pub mod kinematics;
 
 pub use arc::{ArcAtHeight, ArcChip};
+pub use closed_form::{
+    arc_iuct, closed_forms, equivalent_iuct, pass_terms, ClosedForms, EquivalentParams, PassTerms,
+};
+pub use exact::{exact_iuct, exact_on_ray, ray_crossing, ExactIuct, NewtonOptions, Ray, RayCrossing};
+pub use kinematics::{
+    ClPath, ClPoint, CircularFeed, ConstantSwing, EdgeState, Pose, SpindlePoint, SpindleSense,
+    StraightFeed, ToolKinematics, ToolMotion, Vec3,
+};
 
 /// A chip-thickness model for steady 3-axis straight feed.
 ///
