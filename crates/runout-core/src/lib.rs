@@ -27,7 +27,7 @@ pub mod error;
 pub mod force;
 pub mod runout;
 
-pub use chip::{ArcChip, ChipAtHeight, ChipThickness};
+pub use chip::{ArcChip, ChipAtHeight, ChipThickness, EquivalentChip, ExactChip};
 pub use coefficients::CuttingCoefficients;
 pub use cut::{Cut, Engagement, MillingMode};
 pub use cutter::{Cutter, RadiusProfile};

@@ -7,12 +7,19 @@
 
 mod arc;
 pub mod closed_form;
+pub mod compare;
+pub mod compensation;
 pub mod exact;
 pub mod kinematics;
+mod straight;
 
 pub use arc::{ArcAtHeight, ArcChip};
 pub use closed_form::{
     arc_iuct, closed_forms, equivalent_iuct, pass_terms, ClosedForms, EquivalentParams, PassTerms,
+};
+pub use compensation::{calibration_grid, fit_compensation, CalibrationPoint, CompensationFit};
+pub use straight::{
+    straight_feed_kinematics, EquivalentAtHeight, EquivalentChip, ExactAtHeight, ExactChip,
 };
 pub use exact::{exact_iuct, exact_on_ray, ray_crossing, ExactIuct, NewtonOptions, Ray, RayCrossing};
 pub use kinematics::{
