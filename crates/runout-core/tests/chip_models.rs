@@ -275,6 +275,9 @@ proptest! {
         let t = kin.time_at_tooth_angle(tooth, z, deg(phi));
         let e = exact_iuct(&kin, tooth, z, t, &NewtonOptions::default());
         prop_assert!(e.converged);
+        // the scalar straight-feed solver of the trait path is the same exact model
+        let trait_h = ExactChip::new(&cutter, &runout, fz).unwrap().thickness(tooth, z, deg(phi));
+        prop_assert!((trait_h - e.h()).abs() < 1e-11, "trait {} 3-D {}", trait_h, e.h());
         // one revolution later the geometry is translated by K f_z: same h (steady feed)
         let e2 = exact_iuct(&kin, tooth, z, t + kin.period(), &NewtonOptions::default());
         prop_assert!((e.raw - e2.raw).abs() < 1e-10);

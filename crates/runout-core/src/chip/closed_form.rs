@@ -13,8 +13,8 @@
 //! (the previous *effective* edge aligned with the current ray, eq. 0.2). All results are the raw
 //! minima (negative = no chip); apply max(0, ·).
 
-use super::exact::{aligned_tau, Ray};
-use super::kinematics::{ToolKinematics, ToolMotion};
+use super::exact::Ray;
+use super::kinematics::{HeightGeometry, ToolKinematics, ToolMotion};
 
 /// Compensation parameters of the equivalent model, eq. (2.8).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -101,43 +101,39 @@ pub struct ClosedForms {
     pub equivalent: f64,
 }
 
-/// Terms of pass m for `tooth` at (z, t) given its ray (eq. 2.4 displacement).
+/// Terms of pass m for `tooth` at time `t` on the prepared height `geo` (eq. 2.4 displacement).
 #[inline]
 pub fn pass_terms<M: ToolMotion>(
     kin: &ToolKinematics<M>,
+    geo: &HeightGeometry,
     ray: &Ray,
     tooth: usize,
     m: usize,
-    z: f64,
     t: f64,
     refine: bool,
 ) -> PassTerms {
-    let k = kin.cutter().teeth();
-    let prev = (tooth + k * m - m) % k;
-    let sp = kin.spindle_point(prev, z);
+    let idx = geo.pass_index(tooth, m);
     let tau = if refine {
-        aligned_tau(kin, tooth, m, ray.phase, sp.angle())
+        geo.tau_aligned[idx]
     } else {
-        -kin.gap_time(tooth, m)
+        geo.tau_nominal[idx]
     };
-    let (a, u) = kin.axis_velocity_per_rad(z, t);
-    let tdir = u.cross(&ray.dir) * kin.sense().sigma();
-    let d = ray.origin - kin.axis_point(z, t + tau);
-    let d = d - u * d.dot(&u);
-    let r_prev = sp.radius();
+    let d = ray.displacement(kin, geo.z, t, tau);
+    let r_prev = geo.radius[geo.previous(tooth, m)];
     let delta_r = ray.radius - r_prev;
     let dn = d.dot(&ray.dir);
     PassTerms {
         linear: delta_r + dn,
         delta_r,
         dn,
-        dt: d.dot(&tdir),
-        an: a.dot(&ray.dir),
+        dt: d.dot(&ray.tangent),
+        an: ray.axis_rate.dot(&ray.dir),
         r_prev,
     }
 }
 
-/// Arc, circle-intersection and equivalent IUCT of `tooth` at height `z`, time `t`.
+/// Arc, circle-intersection and equivalent IUCT of `tooth` at height `z`, time `t`
+/// (slow path: prepares the height each call).
 pub fn closed_forms<M: ToolMotion>(
     kin: &ToolKinematics<M>,
     tooth: usize,
@@ -145,19 +141,29 @@ pub fn closed_forms<M: ToolMotion>(
     t: f64,
     params: &EquivalentParams,
 ) -> ClosedForms {
-    let ray = Ray::new(kin, tooth, z, t);
+    closed_forms_at(kin, &kin.at_height(z), tooth, t, params)
+}
+
+/// Arc, circle-intersection and equivalent IUCT on a prepared height.
+pub fn closed_forms_at<M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    geo: &HeightGeometry,
+    tooth: usize,
+    t: f64,
+    params: &EquivalentParams,
+) -> ClosedForms {
+    let ray = Ray::at(kin, geo, tooth, t);
     let mut out = ClosedForms {
         arc: f64::INFINITY,
         circle: f64::INFINITY,
         equivalent: f64::INFINITY,
     };
-    let unrefined = |m| pass_terms(kin, &ray, tooth, m, z, t, false);
-    for m in 1..=kin.cutter().teeth() {
-        let base = unrefined(m);
+    for m in 1..=geo.teeth() {
+        let base = pass_terms(kin, geo, &ray, tooth, m, t, false);
         out.arc = out.arc.min(base.linear);
         out.circle = out.circle.min(base.circle());
         let eq = if params.phase_refinement {
-            pass_terms(kin, &ray, tooth, m, z, t, true)
+            pass_terms(kin, geo, &ray, tooth, m, t, true)
         } else {
             base
         };
@@ -166,8 +172,7 @@ pub fn closed_forms<M: ToolMotion>(
     out
 }
 
-/// Equivalent IUCT only (raw, mm), eq. (2.8): the fast path of [`closed_forms`].
-#[inline]
+/// Equivalent IUCT only (raw, mm), eq. (2.8) (slow path: prepares the height each call).
 pub fn equivalent_iuct<M: ToolMotion>(
     kin: &ToolKinematics<M>,
     tooth: usize,
@@ -175,19 +180,45 @@ pub fn equivalent_iuct<M: ToolMotion>(
     t: f64,
     params: &EquivalentParams,
 ) -> f64 {
-    let ray = Ray::new(kin, tooth, z, t);
-    (1..=kin.cutter().teeth())
-        .map(|m| {
-            pass_terms(kin, &ray, tooth, m, z, t, params.phase_refinement)
-                .equivalent(params.k1, params.k2)
-        })
-        .fold(f64::INFINITY, f64::min)
+    equivalent_at(kin, &kin.at_height(z), tooth, t, params)
 }
 
-/// Linear arc IUCT only (raw, mm), eq. (2.5).
+/// Equivalent IUCT (raw, mm) on a prepared height, eq. (2.8): no iteration, no branches
+/// besides the min.
+#[inline]
+pub fn equivalent_at<M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    geo: &HeightGeometry,
+    tooth: usize,
+    t: f64,
+    params: &EquivalentParams,
+) -> f64 {
+    let ray = Ray::at(kin, geo, tooth, t);
+    let mut h = f64::INFINITY;
+    for m in 1..=geo.teeth() {
+        let p = pass_terms(kin, geo, &ray, tooth, m, t, params.phase_refinement);
+        h = h.min(p.equivalent(params.k1, params.k2));
+    }
+    h
+}
+
+/// Linear arc IUCT only (raw, mm), eq. (2.5) (slow path).
 pub fn arc_iuct<M: ToolMotion>(kin: &ToolKinematics<M>, tooth: usize, z: f64, t: f64) -> f64 {
-    let ray = Ray::new(kin, tooth, z, t);
-    (1..=kin.cutter().teeth())
-        .map(|m| pass_terms(kin, &ray, tooth, m, z, t, false).linear)
-        .fold(f64::INFINITY, f64::min)
+    arc_at(kin, &kin.at_height(z), tooth, t)
+}
+
+/// Linear arc IUCT (raw, mm) on a prepared height, eq. (2.5).
+#[inline]
+pub fn arc_at<M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    geo: &HeightGeometry,
+    tooth: usize,
+    t: f64,
+) -> f64 {
+    let ray = Ray::at(kin, geo, tooth, t);
+    let mut h = f64::INFINITY;
+    for m in 1..=geo.teeth() {
+        h = h.min(pass_terms(kin, geo, &ray, tooth, m, t, false).linear);
+    }
+    h
 }

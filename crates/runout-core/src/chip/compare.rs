@@ -4,10 +4,11 @@
 //! * mean relative error: mean |Δh|/h_exact over points with h_exact > 5 % of max h_exact;
 //! * normalised MAE: Σ|Δh| / Σ h_exact over all points.
 
-use super::closed_form::{closed_forms, equivalent_iuct, EquivalentParams};
-use super::exact::{exact_iuct, NewtonOptions};
+use super::closed_form::{arc_at, closed_forms_at, equivalent_at, EquivalentParams};
+use super::exact::{exact_at, NewtonOptions};
 use super::kinematics::{
-    CircularFeed, ClPath, ConstantSwing, Pose, StraightFeed, ToolKinematics, ToolMotion,
+    CircularFeed, ClPath, ConstantSwing, HeightGeometry, Pose, StraightFeed, ToolKinematics,
+    ToolMotion,
 };
 
 /// Any of the supported tool motions (one type, so a case set can mix them).
@@ -74,6 +75,24 @@ pub struct ModelValues {
     pub equivalent: Vec<f64>,
 }
 
+/// Height geometries of the distinct heights of `points` (looked up by exact equality).
+struct Heights(Vec<HeightGeometry>);
+
+impl Heights {
+    fn new<M: ToolMotion>(kin: &ToolKinematics<M>, points: &[SamplePoint]) -> Self {
+        let mut v: Vec<HeightGeometry> = Vec::new();
+        for q in points {
+            if !v.iter().any(|g| g.z == q.z) {
+                v.push(kin.at_height(q.z));
+            }
+        }
+        Heights(v)
+    }
+    fn get(&self, z: f64) -> &HeightGeometry {
+        self.0.iter().find(|g| g.z == z).expect("prepared")
+    }
+}
+
 /// Evaluate all models at `points`.
 pub fn evaluate_models<M: ToolMotion>(
     kin: &ToolKinematics<M>,
@@ -81,10 +100,12 @@ pub fn evaluate_models<M: ToolMotion>(
     params: &EquivalentParams,
 ) -> ModelValues {
     let opts = NewtonOptions::default();
+    let heights = Heights::new(kin, points);
     let mut v = ModelValues::default();
     for q in points {
-        v.exact.push(exact_iuct(kin, q.tooth, q.z, q.t, &opts).h());
-        let c = closed_forms(kin, q.tooth, q.z, q.t, params);
+        let geo = heights.get(q.z);
+        v.exact.push(exact_at(kin, geo, q.tooth, q.t, &opts).h());
+        let c = closed_forms_at(kin, geo, q.tooth, q.t, params);
         v.arc.push(c.arc.max(0.0));
         v.circle.push(c.circle.max(0.0));
         v.equivalent.push(c.equivalent.max(0.0));
@@ -95,9 +116,10 @@ pub fn evaluate_models<M: ToolMotion>(
 /// Exact h only (for throughput measurement).
 pub fn exact_values<M: ToolMotion>(kin: &ToolKinematics<M>, points: &[SamplePoint]) -> Vec<f64> {
     let opts = NewtonOptions::default();
+    let heights = Heights::new(kin, points);
     points
         .iter()
-        .map(|q| exact_iuct(kin, q.tooth, q.z, q.t, &opts).h())
+        .map(|q| exact_at(kin, heights.get(q.z), q.tooth, q.t, &opts).h())
         .collect()
 }
 
@@ -107,9 +129,19 @@ pub fn equivalent_values<M: ToolMotion>(
     points: &[SamplePoint],
     params: &EquivalentParams,
 ) -> Vec<f64> {
+    let heights = Heights::new(kin, points);
     points
         .iter()
-        .map(|q| equivalent_iuct(kin, q.tooth, q.z, q.t, params).max(0.0))
+        .map(|q| equivalent_at(kin, heights.get(q.z), q.tooth, q.t, params).max(0.0))
+        .collect()
+}
+
+/// Linear-arc h only (for throughput measurement).
+pub fn arc_values<M: ToolMotion>(kin: &ToolKinematics<M>, points: &[SamplePoint]) -> Vec<f64> {
+    let heights = Heights::new(kin, points);
+    points
+        .iter()
+        .map(|q| arc_at(kin, heights.get(q.z), q.tooth, q.t).max(0.0))
         .collect()
 }
 

@@ -8,7 +8,7 @@
 //! reported. Points where the exact tooth does not cut are skipped.
 
 use super::closed_form::{pass_terms, EquivalentParams};
-use super::exact::{exact_on_ray, NewtonOptions, Ray};
+use super::exact::{exact_at, NewtonOptions, Ray};
 use super::kinematics::{ToolKinematics, ToolMotion};
 use crate::error::ParamError;
 use nalgebra::{DMatrix, DVector};
@@ -47,13 +47,14 @@ pub fn fit_compensation<M: ToolMotion>(
     let opts = NewtonOptions::default();
     let mut rows: Vec<[f64; 3]> = Vec::with_capacity(points.len());
     for q in points {
-        let ray = Ray::new(kin, q.tooth, q.z, q.t);
-        let exact = exact_on_ray(kin, &ray, q.tooth, q.z, q.t, &opts);
+        let geo = kin.at_height(q.z);
+        let ray = Ray::at(kin, &geo, q.tooth, q.t);
+        let exact = exact_at(kin, &geo, q.tooth, q.t, &opts);
         if exact.raw <= 0.0 {
             continue;
         }
         let active = (1..=kin.cutter().teeth())
-            .map(|m| pass_terms(kin, &ray, q.tooth, m, q.z, q.t, phase_refinement))
+            .map(|m| pass_terms(kin, &geo, &ray, q.tooth, m, q.t, phase_refinement))
             .min_by(|a, b| a.equivalent(1.0, 1.0).total_cmp(&b.equivalent(1.0, 1.0)))
             .expect("K >= 1");
         rows.push([

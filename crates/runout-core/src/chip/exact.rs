@@ -4,12 +4,12 @@
 //! h_i(z,t) = max(0, R_i(z) − max_{m=1..K} s_m), where s_m solves
 //! E_{i−m}(z′, t + τ) − A(z,t) − s·n = 0 for x = (τ, z′, s) (τ = t′ − t), n = (E_i − A)/|E_i − A|.
 //! Jacobian J = [∂E/∂t, ∂E/∂z, −n] (see [`EdgeState`]); the 3×3 step is solved by Cramer's rule
-//! (no allocation). Start: τ₀ = −gap/ω + (δ_i − δ_{i−m})/ω (previous effective edge aligned with
-//! the ray, methods.md (0.2)), z′ = z, s = R_{i−m}(z). Converged when the step is below
+//! (no allocation). Start: the previous effective edge aligned with the ray,
+//! τ₀ = −gap/ω + (δ_i − δ_{i−m})/ω (methods.md eq. 0.2), corrected by the second-order crossing
+//! angle of eq. (2.7); z′ = z. Converged when the step is below
 //! `tol_mm` in every component (τ scaled by the edge speed ω·R).
 
-use super::kinematics::{EdgeState, SpindlePoint, ToolKinematics, ToolMotion, Vec3};
-use crate::angle::wrap_pi;
+use super::kinematics::{small_sin_cos, HeightGeometry, ToolKinematics, ToolMotion, Vec3};
 
 /// Newton settings: convergence tolerance (mm) and iteration cap per previous tooth.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -70,90 +70,138 @@ pub struct RayCrossing {
 #[inline]
 fn solve3(c0: &Vec3, c1: &Vec3, c2: &Vec3, b: &Vec3) -> Vec3 {
     let c12 = c1.cross(c2);
-    let det = c0.dot(&c12);
+    let inv = 1.0 / c0.dot(&c12);
     Vec3::new(
-        b.dot(&c12) / det,
-        c0.dot(&b.cross(c2)) / det,
-        c0.dot(&c1.cross(b)) / det,
+        b.dot(&c12) * inv,
+        c0.dot(&b.cross(c2)) * inv,
+        c0.dot(&c1.cross(b)) * inv,
     )
 }
 
-/// The current tooth's ray: axis point A, unit direction n, effective radius R_i.
+/// The current tooth's ray and the local motion quantities of methods.md §2.4.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ray {
     /// A(z,t) (mm).
     pub origin: Vec3,
     /// n (unit).
     pub dir: Vec3,
+    /// t̂ = σ·u × n: direction of the edge motion for increasing spindle angle.
+    pub tangent: Vec3,
+    /// Tool axis u(t).
+    pub axis: Vec3,
+    /// a = Ȧ/ω, axis-point velocity per radian of spindle rotation (mm/rad).
+    pub axis_rate: Vec3,
     /// R_i(z) = |E_i − A| (mm).
     pub radius: f64,
-    /// Spindle-frame angle ψ_i + δ_i of the effective edge (rad).
-    pub phase: f64,
+    /// (sin Θ(t), cos Θ(t)) of the spindle angle at the ray's time.
+    pub spin: (f64, f64),
 }
 
 impl Ray {
-    /// Ray of `tooth` at height `z`, time `t`.
+    /// Ray of `tooth` at height `z`, time `t` (slow path: prepares the height).
     pub fn new<M: ToolMotion>(kin: &ToolKinematics<M>, tooth: usize, z: f64, t: f64) -> Self {
-        let sp = kin.spindle_point(tooth, z);
-        let st = kin.edge_at(&sp, z, t, 0.0);
-        Self::from_edge(&st, &sp)
+        Self::at(kin, &kin.at_height(z), tooth, t)
     }
 
-    /// Ray from an evaluated edge state.
+    /// Ray of `tooth` at time `t` on the prepared height `geo`.
     #[inline]
-    pub fn from_edge(st: &EdgeState, sp: &SpindlePoint) -> Self {
+    pub fn at<M: ToolMotion>(
+        kin: &ToolKinematics<M>,
+        geo: &HeightGeometry,
+        tooth: usize,
+        t: f64,
+    ) -> Self {
+        let pose = kin.motion().pose(t);
+        let spin = kin.spindle_angle(t).sin_cos();
+        let st = kin.edge_from_pose_sc(&pose, &geo.points[tooth], geo.z, spin.0, spin.1);
         let r = st.pos - st.axis_point;
         let radius = r.norm();
+        let dir = r * (1.0 / radius);
         Ray {
             origin: st.axis_point,
-            dir: r / radius,
+            dir,
+            tangent: pose.u.cross(&dir) * kin.sense().sigma(),
+            axis: pose.u,
+            axis_rate: (pose.v + pose.w.cross(&pose.u) * geo.z) * kin.inv_omega(),
             radius,
-            phase: sp.angle(),
+            spin,
         }
+    }
+
+    /// Axis displacement d = [A(z,t) − A(z,t+τ)]_⊥u since time t + τ (mm), eq. (2.4).
+    #[inline]
+    pub fn displacement<M: ToolMotion>(&self, kin: &ToolKinematics<M>, z: f64, t: f64, tau: f64) -> Vec3 {
+        let d = self.origin - kin.axis_point(z, t + tau);
+        d - self.axis * d.dot(&self.axis)
     }
 }
 
-/// Start value of τ for previous tooth `prev` passing `m` gaps before `tooth`: the previous
-/// effective edge aligned with the current one (methods.md §2.4 refinement).
+/// Start for the crossing of the previous tooth aligned at look-back τ₀ (methods.md §2.4):
+/// R_p sin ψ + (a·t̂)ψ = d·t̂, from ψ₀ = d·t̂/(R_p + a·t̂) (eq. 2.7) refined by two scalar Newton
+/// steps, then s = R_p cos ψ − d·n + ψ a·n. For straight feed this is already the exact crossing,
+/// so the 3-D Newton below converges in one step; otherwise it is a third-order start.
 #[inline]
-pub fn aligned_tau<M: ToolMotion>(
+fn start_point<M: ToolMotion>(
     kin: &ToolKinematics<M>,
-    tooth: usize,
-    m: usize,
-    ray_phase: f64,
-    prev_phase: f64,
-) -> f64 {
-    let gap = kin.gap_time(tooth, m);
-    -gap + wrap_pi(ray_phase - prev_phase + gap * kin.omega()) / kin.omega()
+    ray: &Ray,
+    z: f64,
+    t: f64,
+    tau0: f64,
+    r_prev: f64,
+) -> [f64; 3] {
+    let d = ray.displacement(kin, z, t, tau0);
+    let dt = d.dot(&ray.tangent);
+    let at = ray.axis_rate.dot(&ray.tangent);
+    let mut psi = dt / (r_prev + at);
+    for _ in 0..2 {
+        let (sn, cs) = small_sin_cos(psi);
+        psi -= (r_prev * sn + at * psi - dt) / (r_prev * cs + at);
+    }
+    let cs = small_sin_cos(psi).1;
+    let s = r_prev * cs - d.dot(&ray.dir) + psi * ray.axis_rate.dot(&ray.dir);
+    [tau0 + psi * kin.inv_omega(), z, s]
 }
 
-/// Newton solve of eq. (2.3) for the previous tooth `prev` (m gaps before `tooth`).
-pub fn ray_crossing<M: ToolMotion>(
+/// Newton solve of eq. (2.3) for the previous tooth m passes before `tooth` on height `geo`.
+#[inline]
+pub fn crossing_at<M: ToolMotion>(
     kin: &ToolKinematics<M>,
+    geo: &HeightGeometry,
     ray: &Ray,
     tooth: usize,
     m: usize,
-    z: f64,
     t: f64,
     opts: &NewtonOptions,
 ) -> RayCrossing {
-    let k = kin.cutter().teeth();
-    let prev = (tooth + k * m - m) % k;
-    let sp0 = kin.spindle_point(prev, z);
-    let mut x = [aligned_tau(kin, tooth, m, ray.phase, sp0.angle()), z, sp0.radius()];
-    let speed = kin.omega() * ray.radius;
+    let prev = geo.previous(tooth, m);
+    let z = geo.z;
+    let sp0 = geo.points[prev];
+    let r_prev = geo.radius[prev];
+    let idx = geo.pass_index(tooth, m);
+    let tau0 = geo.tau_aligned[idx];
+    let mut x = start_point(kin, ray, z, t, tau0, r_prev);
+    // sin/cos of Θ(t + τ₀) by the addition theorem; the Newton iterates differ from τ₀ by a
+    // small angle ε = ω(τ − τ₀) whose sin/cos come from `small_sin_cos` (no libm in the loop)
+    let (sa, ca) = geo.turn_aligned[idx];
+    let (st0, ct0) = ray.spin;
+    let (sb, cb) = (st0 * ca + ct0 * sa, ct0 * ca - st0 * sa);
+    let speed = kin.omega() * r_prev;
+    let minus_n = -ray.dir;
     let mut iterations = 0;
     let mut converged = false;
     while iterations < opts.max_iter {
         iterations += 1;
+        // straight feed keeps z′ = z exactly (the u-row decouples), so the cached point is used
         let sp = if x[1] == z {
             sp0
         } else {
             kin.spindle_point(prev, x[1])
         };
-        let st = kin.edge_at(&sp, x[1], t, x[0]);
+        let (se, ce) = small_sin_cos(kin.omega() * (x[0] - tau0));
+        let pose = kin.motion().pose(t + x[0]);
+        let st = kin.edge_from_pose_sc(&pose, &sp, x[1], sb * ce + cb * se, cb * ce - sb * se);
         let f = st.pos - ray.origin - ray.dir * x[2];
-        let dx = solve3(&st.d_dt, &st.d_dz, &(-ray.dir), &(-f));
+        let dx = solve3(&st.d_dt, &st.d_dz, &minus_n, &(-f));
         x[0] += dx[0];
         x[1] += dx[1];
         x[2] += dx[2];
@@ -174,7 +222,22 @@ pub fn ray_crossing<M: ToolMotion>(
     }
 }
 
+/// Newton solve of eq. (2.3) for one previous pass m (slow path: prepares the height).
+pub fn ray_crossing<M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    tooth: usize,
+    m: usize,
+    z: f64,
+    t: f64,
+    opts: &NewtonOptions,
+) -> RayCrossing {
+    let geo = kin.at_height(z);
+    let ray = Ray::at(kin, &geo, tooth, t);
+    crossing_at(kin, &geo, &ray, tooth, m, t, opts)
+}
+
 /// Exact IUCT of `tooth` at height `z` and time `t`, eq. (2.2): min over the K previous passes.
+/// Slow path (prepares the height each call); loops use [`exact_at`].
 ///
 /// ```
 /// use runout_core::chip::*;
@@ -195,26 +258,25 @@ pub fn exact_iuct<M: ToolMotion>(
     t: f64,
     opts: &NewtonOptions,
 ) -> ExactIuct {
-    let ray = Ray::new(kin, tooth, z, t);
-    exact_on_ray(kin, &ray, tooth, z, t, opts)
+    exact_at(kin, &kin.at_height(z), tooth, t, opts)
 }
 
-/// Exact IUCT for an already computed ray.
+/// Exact IUCT on a prepared height, eq. (2.2).
 #[inline]
-pub fn exact_on_ray<M: ToolMotion>(
+pub fn exact_at<M: ToolMotion>(
     kin: &ToolKinematics<M>,
-    ray: &Ray,
+    geo: &HeightGeometry,
     tooth: usize,
-    z: f64,
     t: f64,
     opts: &NewtonOptions,
 ) -> ExactIuct {
+    let ray = Ray::at(kin, geo, tooth, t);
     let mut best = f64::NEG_INFINITY;
     let mut cutting_m = 1;
     let mut iterations = 0;
     let mut converged = true;
-    for m in 1..=kin.cutter().teeth() {
-        let c = ray_crossing(kin, ray, tooth, m, z, t, opts);
+    for m in 1..=geo.teeth() {
+        let c = crossing_at(kin, geo, &ray, tooth, m, t, opts);
         iterations += c.iterations;
         converged &= c.converged;
         if c.s > best {

@@ -461,6 +461,7 @@ pub struct ToolKinematics<M> {
     cutter: Cutter,
     runout: Runout,
     omega: f64,
+    inv_omega: f64,
     theta0: f64,
     sense: SpindleSense,
     motion: M,
@@ -490,6 +491,7 @@ impl<M: ToolMotion> ToolKinematics<M> {
             cutter: cutter.clone(),
             runout: *runout,
             omega,
+            inv_omega: 1.0 / omega,
             theta0: theta0_rad,
             sense,
             motion,
@@ -506,8 +508,14 @@ impl<M: ToolMotion> ToolKinematics<M> {
         &self.runout
     }
     /// Spindle speed ω (rad/s).
+    #[inline]
     pub fn omega(&self) -> f64 {
         self.omega
+    }
+    /// 1/ω (s/rad).
+    #[inline]
+    pub fn inv_omega(&self) -> f64 {
+        self.inv_omega
     }
     /// Tooth period T/K for uniform pitch; in general the gap time, see [`Self::gap_time`].
     pub fn period(&self) -> f64 {
@@ -569,7 +577,7 @@ impl<M: ToolMotion> ToolKinematics<M> {
     #[inline]
     pub fn axis_velocity_per_rad(&self, z: f64, t: f64) -> (Vec3, Vec3) {
         let p = self.motion.pose(t);
-        ((p.v + p.w.cross(&p.u) * z) / self.omega, p.u)
+        ((p.v + p.w.cross(&p.u) * z) * self.inv_omega, p.u)
     }
 
     /// Edge state of the tooth with spindle point `sp` at time `t + tau`, with the spindle angle
@@ -584,8 +592,21 @@ impl<M: ToolMotion> ToolKinematics<M> {
     /// Edge state from a pose and spindle angle Θ (eq. 2.1 and its derivatives).
     #[inline]
     pub fn edge_from_pose(&self, pose: &Pose, sp: &SpindlePoint, z: f64, theta: f64) -> EdgeState {
-        let e2 = pose.u.cross(&pose.e1) * self.sense.sigma();
         let (sn, cs) = theta.sin_cos();
+        self.edge_from_pose_sc(pose, sp, z, sn, cs)
+    }
+
+    /// Edge state from a pose and (sin Θ, cos Θ).
+    #[inline]
+    pub fn edge_from_pose_sc(
+        &self,
+        pose: &Pose,
+        sp: &SpindlePoint,
+        z: f64,
+        sn: f64,
+        cs: f64,
+    ) -> EdgeState {
+        let e2 = pose.u.cross(&pose.e1) * self.sense.sigma();
         let [x, y] = sp.xy;
         let [dx, dy] = sp.dxy;
         let a = x * cs - y * sn;
@@ -610,4 +631,118 @@ impl<M: ToolMotion> ToolKinematics<M> {
         let sp = self.spindle_point(tooth, z);
         self.edge_at(&sp, z, t, 0.0).pos
     }
+}
+
+/// Everything of the kinematics that depends on the height z only (precomputed once per height
+/// so that the per-point solvers do no trigonometry of the tooth geometry).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeightGeometry {
+    /// Height z (mm).
+    pub z: f64,
+    k: usize,
+    /// Spindle-frame edge point per tooth.
+    pub points: Vec<SpindlePoint>,
+    /// Effective radius R_i(z) per tooth (mm), eq. (0.1).
+    pub radius: Vec<f64>,
+    /// Effective edge angle ψ_i + δ_i per tooth (rad), eq. (0.2).
+    pub phase: Vec<f64>,
+    /// Look-back τ = −gap/ω (s) per (tooth, m): `[i*K + m−1]`.
+    pub tau_nominal: Vec<f64>,
+    /// Look-back τ = −gap/ω + (δ_i − δ_{i−m})/ω (s): previous effective edge aligned with the ray.
+    pub tau_aligned: Vec<f64>,
+    /// (sin, cos) of ω·τ_aligned per (tooth, m).
+    pub turn_aligned: Vec<(f64, f64)>,
+    /// Tooth i − m per (tooth, m).
+    prev: Vec<usize>,
+}
+
+impl HeightGeometry {
+    /// Number of teeth.
+    pub fn teeth(&self) -> usize {
+        self.k
+    }
+    /// Index i·K + m − 1 of the (tooth, m) tables.
+    #[inline]
+    pub fn pass_index(&self, tooth: usize, m: usize) -> usize {
+        tooth * self.k + m - 1
+    }
+    /// Tooth i − m (cyclic).
+    #[inline]
+    pub fn previous(&self, tooth: usize, m: usize) -> usize {
+        self.prev[self.pass_index(tooth, m)]
+    }
+}
+
+impl<M: ToolMotion> ToolKinematics<M> {
+    /// Precompute the height-dependent geometry at `z`.
+    pub fn at_height(&self, z: f64) -> HeightGeometry {
+        let k = self.cutter.teeth();
+        let points: Vec<SpindlePoint> = (0..k).map(|i| self.spindle_point(i, z)).collect();
+        let radius: Vec<f64> = points.iter().map(SpindlePoint::radius).collect();
+        let phase: Vec<f64> = points.iter().map(SpindlePoint::angle).collect();
+        let mut tau_nominal = Vec::with_capacity(k * k);
+        let mut tau_aligned = Vec::with_capacity(k * k);
+        for i in 0..k {
+            for m in 1..=k {
+                let p = (i + k * m - m) % k;
+                let gap = self.gap_time(i, m);
+                let shift = crate::angle::wrap_pi(phase[i] - phase[p] + gap * self.omega);
+                tau_nominal.push(-gap);
+                tau_aligned.push(-gap + shift / self.omega);
+            }
+        }
+        let turn_aligned = tau_aligned.iter().map(|t| (t * self.omega).sin_cos()).collect();
+        let prev = (0..k * k).map(|q| (q / k + k * (q % k + 1) - (q % k + 1)) % k).collect();
+        HeightGeometry {
+            prev,
+            turn_aligned,
+            z,
+            k,
+            points,
+            radius,
+            phase,
+            tau_nominal,
+            tau_aligned,
+        }
+    }
+}
+
+/// (sin x, cos x) for a small angle by Taylor polynomials of degree 15/16 in Horner form
+/// (|x| ≤ 0.5: truncation error below 1e-19, i.e. correctly rounded to ~1 ulp), libm otherwise.
+/// Used for the Newton increments of the spindle angle: ~3× cheaper than libm `sin_cos`
+/// (measured in `benches/chip.rs`, which prints the libm baseline) at full double accuracy.
+#[inline]
+pub fn small_sin_cos(x: f64) -> (f64, f64) {
+    const S: [f64; 7] = [
+        -1.0 / 6.0,
+        1.0 / 120.0,
+        -1.0 / 5040.0,
+        1.0 / 362_880.0,
+        -1.0 / 39_916_800.0,
+        1.0 / 6_227_020_800.0,
+        -1.0 / 1_307_674_368_000.0,
+    ];
+    const C: [f64; 8] = [
+        -1.0 / 2.0,
+        1.0 / 24.0,
+        -1.0 / 720.0,
+        1.0 / 40_320.0,
+        -1.0 / 3_628_800.0,
+        1.0 / 479_001_600.0,
+        -1.0 / 87_178_291_200.0,
+        1.0 / 20_922_789_888_000.0,
+    ];
+    let q = x * x;
+    if q < 0.015625 {
+        // |x| ≤ 1/8: degree 9/10 suffice (next terms x¹¹/11! < 3e-18, x¹²/12! < 4e-20)
+        let ps = S[..4].iter().rev().fold(0.0, |acc, c| acc * q + c);
+        let pc = C[..5].iter().rev().fold(0.0, |acc, c| acc * q + c);
+        return (x + x * q * ps, 1.0 + q * pc);
+    }
+    if x.abs() > 0.5 {
+        return x.sin_cos();
+    }
+    let ps = S.iter().rev().fold(0.0, |acc, c| acc * q + c);
+    let pc = C.iter().rev().fold(0.0, |acc, c| acc * q + c);
+    (x + x * q * ps, 1.0 + q * pc)
 }

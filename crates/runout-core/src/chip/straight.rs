@@ -8,15 +8,14 @@
 //! speed is immaterial; the kinematics run at 60 rpm (T = 1 s) with feed K·f_z per revolution.
 
 use super::closed_form::EquivalentParams;
-use super::exact::{exact_iuct, NewtonOptions};
-use super::kinematics::{SpindleSense, StraightFeed, ToolKinematics};
+use super::exact::NewtonOptions;
+use super::kinematics::{small_sin_cos, SpindleSense, StraightFeed, ToolKinematics};
 use super::{ChipAtHeight, ChipThickness};
 use crate::angle::wrap_pi;
 use crate::cutter::Cutter;
 use crate::error::{positive, ParamError};
 use crate::runout::Runout;
 use std::f64::consts::TAU;
-use std::sync::Arc;
 
 /// Spindle speed of the internal kinematics (rpm): any value gives the same h.
 const RPM: f64 = 60.0;
@@ -42,6 +41,17 @@ pub fn straight_feed_kinematics(
 
 /// Exact IUCT (methods.md eq. 2.2–2.3) in steady 3-axis straight feed.
 ///
+/// With a constant axis the trajectory of every edge point at height z stays in the plane of the
+/// ray, so eq. (2.3) reduces exactly to one scalar equation (methods.md §2.4, "exact-for-straight-
+/// feed alternative"): with the previous tooth's effective edge aligned with the ray at look-back
+/// τ₀ (eq. 0.2), d = K f_z·(turn/2π)·x̂ the feed since then, a = K f_z/2π·x̂ the feed per radian and
+/// ψ the further spindle rotation to the crossing,
+///
+/// R_p sin ψ + (a·t̂)ψ = d·t̂,   s = R_p cos ψ − d·n + ψ (a·n),   h = max(0, R_i − max_m s_m),
+///
+/// solved by Newton in ψ to |Δψ|·R_p < 1e-12 mm. Identical to [`super::exact_iuct`] (3-D Newton)
+/// on [`straight_feed_kinematics`] (tested to 1e-11 mm).
+///
 /// ```
 /// use runout_core::{ChipThickness, Cutter, Runout, ExactChip};
 /// let cutter = Cutter::flat(10.0, 4, 0.0).unwrap();
@@ -52,29 +62,109 @@ pub fn straight_feed_kinematics(
 /// ```
 #[derive(Debug, Clone)]
 pub struct ExactChip {
-    kin: Arc<ToolKinematics<StraightFeed>>,
+    cutter: Cutter,
+    runout: Runout,
+    fz: f64,
     opts: NewtonOptions,
 }
 
 impl ExactChip {
     /// Model for `cutter` with `runout` at feed per tooth `fz_mm`.
     pub fn new(cutter: &Cutter, runout: &Runout, fz_mm: f64) -> Result<Self, ParamError> {
+        positive("fz_mm", fz_mm)?;
         Ok(ExactChip {
-            kin: Arc::new(straight_feed_kinematics(cutter, runout, fz_mm)?),
+            cutter: cutter.clone(),
+            runout: *runout,
+            fz: fz_mm,
             opts: NewtonOptions::default(),
         })
     }
-    /// The underlying kinematics.
-    pub fn kinematics(&self) -> &ToolKinematics<StraightFeed> {
-        &self.kin
+    /// The equivalent 3-D kinematics (for the general solvers).
+    pub fn kinematics(&self) -> ToolKinematics<StraightFeed> {
+        straight_feed_kinematics(&self.cutter, &self.runout, self.fz).expect("validated")
+    }
+}
+
+/// Per (tooth, m) constants of the straight-feed models at one height.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Pass {
+    /// R_i − R_{i−m} (mm).
+    delta_r: f64,
+    /// R_{i−m} (mm).
+    r_prev: f64,
+    /// 1/R_{i−m} (1/mm).
+    inv_r_prev: f64,
+    /// Feed D_m since the aligned (or nominal) pass of tooth i − m (mm).
+    d: f64,
+}
+
+/// Per-height tables shared by the straight-feed exact and equivalent models.
+#[derive(Debug, Clone)]
+struct StraightHeight {
+    k: usize,
+    /// (cos δ_i, sin δ_i) per tooth.
+    shift: Vec<(f64, f64)>,
+    pass: Vec<Pass>,
+    /// Feed per radian K f_z/2π (mm/rad).
+    a: f64,
+}
+
+impl StraightHeight {
+    fn new(cutter: &Cutter, runout: &Runout, fz: f64, z: f64, aligned: bool) -> Self {
+        let k = cutter.teeth();
+        let feed_rev = fz * k as f64;
+        let pts: Vec<(f64, f64)> = (0..k).map(|i| runout.tooth_point(cutter, i, z)).collect();
+        let radius = |i: usize| pts[i].0.hypot(pts[i].1);
+        let phase = |i: usize| pts[i].1.atan2(pts[i].0);
+        let shift = (0..k)
+            .map(|i| {
+                let d = wrap_pi(phase(i) - cutter.tooth_angle(i, z));
+                (d.cos(), d.sin())
+            })
+            .collect();
+        let mut pass = Vec::with_capacity(k * k);
+        for i in 0..k {
+            for m in 1..=k {
+                let p = (i + k * m - m) % k;
+                let gap = cutter.gap(i, m);
+                let turn = if aligned {
+                    gap - wrap_pi(phase(i) - phase(p) + gap)
+                } else {
+                    gap
+                };
+                pass.push(Pass {
+                    delta_r: radius(i) - radius(p),
+                    r_prev: radius(p),
+                    inv_r_prev: 1.0 / radius(p),
+                    d: feed_rev * turn / TAU,
+                });
+            }
+        }
+        StraightHeight {
+            k,
+            shift,
+            pass,
+            a: feed_rev / TAU,
+        }
+    }
+
+    /// (sin, cos) of the effective immersion φ + δ_i.
+    #[inline]
+    fn effective(&self, tooth: usize, sin_phi: f64, cos_phi: f64) -> (f64, f64) {
+        let (cd, sd) = self.shift[tooth];
+        (sin_phi * cd + cos_phi * sd, cos_phi * cd - sin_phi * sd)
+    }
+
+    #[inline]
+    fn passes(&self, tooth: usize) -> &[Pass] {
+        &self.pass[tooth * self.k..(tooth + 1) * self.k]
     }
 }
 
 /// [`ExactChip`] at one height.
 #[derive(Debug, Clone)]
 pub struct ExactAtHeight {
-    kin: Arc<ToolKinematics<StraightFeed>>,
-    z: f64,
+    geo: StraightHeight,
     opts: NewtonOptions,
 }
 
@@ -85,17 +175,42 @@ impl ChipThickness for ExactChip {
     }
     fn at_height(&self, z: f64) -> ExactAtHeight {
         ExactAtHeight {
-            kin: self.kin.clone(),
-            z,
+            geo: StraightHeight::new(&self.cutter, &self.runout, self.fz, z, true),
             opts: self.opts,
         }
     }
 }
 
+impl ExactAtHeight {
+    /// R_i − s_m for one previous pass: scalar Newton on ψ (see [`ExactChip`]).
+    #[inline]
+    fn pass_thickness(&self, p: &Pass, s: f64, c: f64) -> f64 {
+        let a = self.geo.a;
+        let (dt, at) = (p.d * c, a * c);
+        let mut psi = dt / (p.r_prev + at);
+        for _ in 0..self.opts.max_iter {
+            let (sn, cs) = small_sin_cos(psi);
+            let step = (p.r_prev * sn + at * psi - dt) / (p.r_prev * cs + at);
+            psi -= step;
+            if (step * p.r_prev).abs() < self.opts.tol_mm {
+                break;
+            }
+        }
+        let cs = small_sin_cos(psi).1;
+        // R_i − s = ΔR + R_p − (R_p cos ψ − d·n + ψ a·n)
+        p.delta_r + p.r_prev * (1.0 - cs) + p.d * s - psi * a * s
+    }
+}
+
 impl ChipAtHeight for ExactAtHeight {
-    fn thickness(&self, tooth: usize, phi: f64, _sin_phi: f64, _cos_phi: f64) -> f64 {
-        let t = self.kin.time_at_tooth_angle(tooth, self.z, phi);
-        exact_iuct(&self.kin, tooth, self.z, t, &self.opts).h()
+    #[inline]
+    fn thickness(&self, tooth: usize, _phi: f64, sin_phi: f64, cos_phi: f64) -> f64 {
+        let (s, c) = self.geo.effective(tooth, sin_phi, cos_phi);
+        let mut h = f64::INFINITY;
+        for p in self.geo.passes(tooth) {
+            h = h.min(self.pass_thickness(p, s, c));
+        }
+        h.max(0.0)
     }
 }
 
@@ -133,24 +248,12 @@ impl EquivalentChip {
     }
 }
 
-/// Per (tooth, m) constants of [`EquivalentChip`] at one height.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct PassConst {
-    delta_r: f64,
-    d: f64,
-    /// k₁·D²/(2R_p)
-    c1: f64,
-    /// k₂·D·a/R_p
-    c2: f64,
-}
-
 /// [`EquivalentChip`] at one height.
 #[derive(Debug, Clone)]
 pub struct EquivalentAtHeight {
-    k: usize,
-    /// (cos δ_i, sin δ_i) per tooth.
-    shift: Vec<(f64, f64)>,
-    pass: Vec<PassConst>,
+    geo: StraightHeight,
+    k1: f64,
+    k2: f64,
 }
 
 impl ChipThickness for EquivalentChip {
@@ -159,53 +262,31 @@ impl ChipThickness for EquivalentChip {
         "equivalent"
     }
     fn at_height(&self, z: f64) -> EquivalentAtHeight {
-        let k = self.cutter.teeth();
-        let feed_rev = self.fz * k as f64;
-        let a = feed_rev / TAU;
-        let pts: Vec<(f64, f64)> = (0..k)
-            .map(|i| self.runout.tooth_point(&self.cutter, i, z))
-            .collect();
-        let radius = |i: usize| pts[i].0.hypot(pts[i].1);
-        let phase = |i: usize| pts[i].1.atan2(pts[i].0);
-        let shift = (0..k)
-            .map(|i| {
-                let d = wrap_pi(phase(i) - self.cutter.tooth_angle(i, z));
-                (d.cos(), d.sin())
-            })
-            .collect();
-        let mut pass = Vec::with_capacity(k * k);
-        for i in 0..k {
-            for m in 1..=k {
-                let p = (i + k * m - m) % k;
-                let gap = self.cutter.gap(i, m);
-                let turn = if self.params.phase_refinement {
-                    gap - wrap_pi(phase(i) - phase(p) + gap)
-                } else {
-                    gap
-                };
-                let d = feed_rev * turn / TAU;
-                let rp = radius(p);
-                pass.push(PassConst {
-                    delta_r: radius(i) - rp,
-                    d,
-                    c1: self.params.k1 * d * d / (2.0 * rp),
-                    c2: self.params.k2 * d * a / rp,
-                });
-            }
+        EquivalentAtHeight {
+            geo: StraightHeight::new(
+                &self.cutter,
+                &self.runout,
+                self.fz,
+                z,
+                self.params.phase_refinement,
+            ),
+            k1: self.params.k1,
+            k2: self.params.k2,
         }
-        EquivalentAtHeight { k, shift, pass }
     }
 }
 
 impl ChipAtHeight for EquivalentAtHeight {
     #[inline]
     fn thickness(&self, tooth: usize, _phi: f64, sin_phi: f64, cos_phi: f64) -> f64 {
-        let (cd, sd) = self.shift[tooth];
-        let s = sin_phi * cd + cos_phi * sd;
-        let c = cos_phi * cd - sin_phi * sd;
+        let (s, c) = self.geo.effective(tooth, sin_phi, cos_phi);
+        let a = self.geo.a;
         let mut h = f64::INFINITY;
-        for p in &self.pass[tooth * self.k..(tooth + 1) * self.k] {
-            h = h.min(p.delta_r + p.d * s + p.c1 * c * c - p.c2 * c * s);
+        for p in self.geo.passes(tooth) {
+            let dt = p.d * c;
+            let circle = 0.5 * dt * dt * p.inv_r_prev;
+            let trochoid = dt * a * s * p.inv_r_prev;
+            h = h.min(p.delta_r + p.d * s + self.k1 * circle - self.k2 * trochoid);
         }
         h.max(0.0)
     }
