@@ -9,4 +9,5 @@ pub mod config;
 pub mod export;
 pub mod plot;
 pub mod recording;
+pub mod toolpath;
 pub mod units;
