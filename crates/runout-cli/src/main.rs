@@ -23,12 +23,15 @@ struct Cli {
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
     Simulate(cmd::simulate::Args),
+    /// Chip thickness with runout (exact, arc, equivalent models; 3-axis and 5-axis toolpaths).
+    Chip(cmd::chip::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
+        Command::Chip(a) => cmd::chip::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -2,6 +2,7 @@
 //! plain numbers or strings with a matching unit suffix (`"8um"`). Every key also exists as a
 //! command-line flag; flags override the file.
 
+pub mod chip;
 pub mod simulate;
 
 use crate::units::{parse_quantity, Quantity};
