@@ -20,6 +20,7 @@ struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
+#[allow(clippy::large_enum_variant)] // parsed once per run; boxing buys nothing
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
     Simulate(cmd::simulate::Args),

@@ -11,7 +11,9 @@ fn runout() -> Command {
 }
 
 fn example(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/chip").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/chip")
+        .join(name)
 }
 
 fn json_of(out: &[u8]) -> serde_json::Value {
@@ -26,7 +28,11 @@ fn compare_shipped_case_set_meets_accuracy_target() {
         .args(["--json", "-"])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v = json_of(&out.stdout);
     assert_eq!(v["schema"], "runout.chip.compare/1");
     assert_eq!(v["cases"].as_array().unwrap().len(), 9);
@@ -50,7 +56,10 @@ fn compare_text_states_both_metrics_and_fit() {
         .unwrap();
     assert!(out.status.success());
     let s = String::from_utf8_lossy(&out.stdout);
-    assert!(s.contains("mean |Δh|/h") && s.contains("normalised MAE"), "{s}");
+    assert!(
+        s.contains("mean |Δh|/h") && s.contains("normalised MAE"),
+        "{s}"
+    );
     assert!(s.contains("fitted k1"), "{s}");
     assert!(s.contains("throughput (points/s"), "{s}");
 }
@@ -73,13 +82,20 @@ fn eval_path_writes_csv_plots_and_json() {
         .args(["--json", "-"])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v = json_of(&out.stdout);
     assert_eq!(v["schema"], "runout.chip.eval/1");
     assert_eq!(v["motion"], "path");
     let text = fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
-    assert_eq!(lines.next().unwrap(), "time_s,spindle_angle_deg,tooth,z_mm,h_equivalent_mm");
+    assert_eq!(
+        lines.next().unwrap(),
+        "time_s,spindle_angle_deg,tooth,z_mm,h_equivalent_mm"
+    );
     // 4 teeth × 5 heights per instant; h within (0, K·f_z] = (0, 0.32] mm
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|f| f.parse().unwrap()).collect())
@@ -119,17 +135,32 @@ fn bad_case_files_name_file_case_and_key() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = dir.path().join("bad.toml");
     fs::write(&cfg, "[[case]]\nname = \"a\"\nteeth = 4\ndiameter_mm = 10\nrpm = 6000\nheights_mm = [0]\nfz_mm = 0.1\nmotion = \"swirl\"\n").unwrap();
-    let out = runout().args(["chip", "compare"]).arg(&cfg).output().unwrap();
+    let out = runout()
+        .args(["chip", "compare"])
+        .arg(&cfg)
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("bad.toml") && err.contains("case `a`") && err.contains("motion"), "{err}");
+    assert!(
+        err.contains("bad.toml") && err.contains("case `a`") && err.contains("motion"),
+        "{err}"
+    );
     fs::write(&cfg, "[[case]]\nname = \"a\"\nteeth = 4\ndiameter_mm = 10\nrpm = 6000\nheights_mm = [0]\nfz_mmm = 0.1\n").unwrap();
-    let out = runout().args(["chip", "compare"]).arg(&cfg).output().unwrap();
+    let out = runout()
+        .args(["chip", "compare"])
+        .arg(&cfg)
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("fz_mmm"), "{err}");
     // a toolpath with a malformed line: error names the CL file and line
-    fs::write(dir.path().join("p.apt"), "MULTAX\nFEDRAT/600\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0,0,0\n").unwrap();
+    fs::write(
+        dir.path().join("p.apt"),
+        "MULTAX\nFEDRAT/600\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0,0,0\n",
+    )
+    .unwrap();
     fs::write(&cfg, "[[case]]\nname = \"p\"\nteeth = 2\ndiameter_mm = 6\nrpm = 6000\nheights_mm = [0]\nmotion = \"path\"\ntoolpath = \"p.apt\"\n").unwrap();
     let out = runout().args(["chip", "eval"]).arg(&cfg).output().unwrap();
     assert!(!out.status.success());
@@ -140,23 +171,71 @@ fn bad_case_files_name_file_case_and_key() {
 #[test]
 fn simulate_with_every_chip_model() {
     let base = [
-        "simulate", "--teeth", "4", "--diameter-mm", "10", "--rpm", "3240", "--fz-mm", "0.08",
-        "--ap-mm", "1", "--ae-mm", "2", "--mode", "down", "--ktc", "1889.2", "--krc", "806.1",
-        "--kac", "291", "--kte", "63.12", "--kre", "113.7", "--kae", "-3.1", "--runout-um", "8",
-        "--step-deg", "0.25", "--revolutions", "1", "--json", "-",
+        "simulate",
+        "--teeth",
+        "4",
+        "--diameter-mm",
+        "10",
+        "--rpm",
+        "3240",
+        "--fz-mm",
+        "0.08",
+        "--ap-mm",
+        "1",
+        "--ae-mm",
+        "2",
+        "--mode",
+        "down",
+        "--ktc",
+        "1889.2",
+        "--krc",
+        "806.1",
+        "--kac",
+        "291",
+        "--kte",
+        "63.12",
+        "--kre",
+        "113.7",
+        "--kae",
+        "-3.1",
+        "--runout-um",
+        "8",
+        "--step-deg",
+        "0.25",
+        "--revolutions",
+        "1",
+        "--json",
+        "-",
     ];
     let peak = |model: &str| {
-        let out = runout().args(base).args(["--chip-model", model]).output().unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let out = runout()
+            .args(base)
+            .args(["--chip-model", model])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let v = json_of(&out.stdout);
         assert_eq!(v["inputs"]["chip_model"], model);
-        v["tooth_peaks"].as_array().unwrap().iter().map(|p| p["peak_fxy_N"].as_f64().unwrap()).fold(0.0, f64::max)
+        v["tooth_peaks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["peak_fxy_N"].as_f64().unwrap())
+            .fold(0.0, f64::max)
     };
     let (a, e, q) = (peak("arc"), peak("exact"), peak("equivalent"));
     // second-order chip terms f/R = 1.6 %: exact within 2 % of arc; equivalent tracks exact
     assert!((e - a).abs() / a < 0.02, "{e} {a}");
     assert!((q - e).abs() / e < 1e-3, "{q} {e}");
-    let out = runout().args(base).args(["--chip-model", "trochoid"]).output().unwrap();
+    let out = runout()
+        .args(base)
+        .args(["--chip-model", "trochoid"])
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("chip_model") && err.contains("exact"), "{err}");

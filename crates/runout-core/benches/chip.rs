@@ -87,8 +87,15 @@ impl Measurement for CpuTime {
 fn kin(motion: Motion) -> ToolKinematics<Motion> {
     let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
     let runout = Runout::new(0.010, 40f64.to_radians()).unwrap();
-    ToolKinematics::new(&cutter, &runout, 6000.0, 0.0, SpindleSense::CounterClockwise, motion)
-        .unwrap()
+    ToolKinematics::new(
+        &cutter,
+        &runout,
+        6000.0,
+        0.0,
+        SpindleSense::CounterClockwise,
+        motion,
+    )
+    .unwrap()
 }
 
 fn straight() -> Motion {
@@ -102,7 +109,13 @@ fn straight() -> Motion {
 
 fn swing() -> Motion {
     Motion::Swing(
-        ConstantSwing::new(Vec3::new(40.0, 0.0, 0.0), Vec3::y(), 60f64.to_radians(), 0.0).unwrap(),
+        ConstantSwing::new(
+            Vec3::new(40.0, 0.0, 0.0),
+            Vec3::y(),
+            60f64.to_radians(),
+            0.0,
+        )
+        .unwrap(),
     )
 }
 
@@ -188,13 +201,17 @@ fn rate(n: usize, mut f: impl FnMut() -> f64) -> f64 {
 fn summary() {
     println!("\n== IUCT throughput summary (thread CPU time, best of 5, points/s) ==");
     let xs: Vec<f64> = (0..4096).map(|q| q as f64 * 0.37).collect();
-    let sc = rate(xs.len(), || xs.iter().map(|x| black_box(*x).sin_cos().0).sum());
+    let sc = rate(xs.len(), || {
+        xs.iter().map(|x| black_box(*x).sin_cos().0).sum()
+    });
     println!("  machine baseline: libm sin_cos {:.1} ns/call", 1e9 / sc);
     let pts = points();
     let params = EquivalentParams::default();
     for (name, k) in [("3-axis", kin(straight())), ("5-axis swing", kin(swing()))] {
         let ex = rate(pts.len(), || exact_values(&k, &pts).iter().sum());
-        let eq = rate(pts.len(), || equivalent_values(&k, &pts, &params).iter().sum());
+        let eq = rate(pts.len(), || {
+            equivalent_values(&k, &pts, &params).iter().sum()
+        });
         let ar = rate(pts.len(), || arc_values(&k, &pts).iter().sum());
         println!(
             "{name:>13} general: exact {:.3e}  equivalent {:.3e} ({:.1}× exact)  arc {:.3e} ({:.1}× exact)",

@@ -33,7 +33,10 @@ fn no_runout_tends_to_fz_sin_phi() {
             let h = exact.thickness(q % 4, 3.0, phi);
             // first order: the deviation is bounded by the second-order terms (1 % margin)
             let err = (h - f * phi.sin()).abs();
-            assert!(err <= 1.01 * second_order_bound(f, 5.0, 4), "f {f} φ {phi}: {err}");
+            assert!(
+                err <= 1.01 * second_order_bound(f, 5.0, 4),
+                "f {f} φ {phi}: {err}"
+            );
         }
     }
 }
@@ -51,7 +54,10 @@ fn no_runout_matches_eq27_to_third_order() {
     let (e1, e2, e3) = (max_err(0.2), max_err(0.1), max_err(0.05));
     // third order: halving f divides the residual by 2³ = 8 (±25 % for the fourth-order rest)
     for ratio in [e1 / e2, e2 / e3] {
-        assert!((6.0..10.0).contains(&ratio), "ratio {ratio} ({e1}, {e2}, {e3})");
+        assert!(
+            (6.0..10.0).contains(&ratio),
+            "ratio {ratio} ({e1}, {e2}, {e3})"
+        );
     }
     // and the residual is small in absolute terms: below f³/R² at f = 0.2, R = 5
     assert!(e1 < 0.2f64.powi(3) / 25.0, "{e1}");
@@ -64,20 +70,34 @@ fn straight_kin(cutter: &Cutter, runout: &Runout, fz: f64) -> ToolKinematics<Str
 #[test]
 fn constant_axis_cl_path_equals_3axis() {
     let cutter = Cutter::flat(8.0, 3, 35.0).unwrap();
-    let runout = Runout::new(0.012, deg(-70.0)).unwrap().with_tilt(2e-4, deg(20.0)).unwrap();
+    let runout = Runout::new(0.012, deg(-70.0))
+        .unwrap()
+        .with_tilt(2e-4, deg(20.0))
+        .unwrap();
     let fz = 0.12;
     let flat = straight_kin(&cutter, &runout, fz);
     let v = flat.motion().v.x; // mm/s
-    // uneven collinear segments along +x, axis +z: the same motion as 3-axis straight feed
+                               // uneven collinear segments along +x, axis +z: the same motion as 3-axis straight feed
     let xs = [-3.0, -1.0, -0.7, 0.4, 2.0, 2.05, 5.0];
     let pts: Vec<ClPoint> = xs
         .iter()
-        .map(|&x| ClPoint { p: Vec3::new(x, 0.0, 0.0), u: Vec3::z(), feed: v })
+        .map(|&x| ClPoint {
+            p: Vec3::new(x, 0.0, 0.0),
+            u: Vec3::z(),
+            feed: v,
+        })
         .collect();
     let path = ClPath::new(&pts).unwrap();
     let t_shift = 3.0 / v; // path time 0 is at x = −3
-    let five = ToolKinematics::new(&cutter, &runout, 60.0, -TAU * t_shift, SpindleSense::Clockwise, path)
-        .unwrap();
+    let five = ToolKinematics::new(
+        &cutter,
+        &runout,
+        60.0,
+        -TAU * t_shift,
+        SpindleSense::Clockwise,
+        path,
+    )
+    .unwrap();
     let opts = NewtonOptions::default();
     for tooth in 0..3 {
         for z in [0.5, 4.0] {
@@ -100,8 +120,15 @@ fn pure_swing_about_tip_is_linear_in_height() {
     let cutter = Cutter::flat(10.0, 4, 0.0).unwrap();
     let omega = deg(10.0);
     let swing = ConstantSwing::new(Vec3::zeros(), Vec3::y(), omega, 0.0).unwrap();
-    let kin = ToolKinematics::new(&cutter, &Runout::none(), 600.0, 0.0, SpindleSense::Clockwise, swing)
-        .unwrap();
+    let kin = ToolKinematics::new(
+        &cutter,
+        &Runout::none(),
+        600.0,
+        0.0,
+        SpindleSense::Clockwise,
+        swing,
+    )
+    .unwrap();
     let tooth_time = 0.1 / 4.0; // T/K at 600 rpm
     let alpha = omega * tooth_time;
     let tilt = 5.0 * alpha * alpha;
@@ -114,18 +141,29 @@ fn pure_swing_about_tip_is_linear_in_height() {
             .iter()
             .map(|&z| exact_iuct(&kin, 0, z, t, &opts).raw)
             .collect();
-        assert!(h[0] <= 1e-12 && h[0] >= -1.02 * 5.0 * (4.0 * alpha).powi(2) / 2.0, "tip: {}", h[0]);
+        assert!(
+            h[0] <= 1e-12 && h[0] >= -1.02 * 5.0 * (4.0 * alpha).powi(2) / 2.0,
+            "tip: {}",
+            h[0]
+        );
         for (j, &z) in heights.iter().enumerate().skip(1) {
             let f = z * alpha; // local feed per tooth at height z (mm)
             let predicted = f * phi.sin();
             // deviation: second-order chip terms + tilt term + axis turn during one tooth
             let tol = second_order_bound(f, 5.0, 4) + tilt + f * alpha;
-            assert!((h[j] - predicted).abs() < tol, "z {z} φ {phi}: {} vs {predicted} ± {tol}", h[j]);
+            assert!(
+                (h[j] - predicted).abs() < tol,
+                "z {z} φ {phi}: {} vs {predicted} ± {tol}",
+                h[j]
+            );
         }
         // linearity: the second difference vanishes to second order in the local feed
         let f20 = 20.0 * alpha;
         let curvature = h[4] - 2.0 * h[3] + h[2];
-        assert!(curvature.abs() < 2.0 * second_order_bound(f20, 5.0, 4) + tilt, "{curvature}");
+        assert!(
+            curvature.abs() < 2.0 * second_order_bound(f20, 5.0, 4) + tilt,
+            "{curvature}"
+        );
         assert!(curvature.abs() < 0.01 * h[4], "{curvature} vs {}", h[4]);
     }
 }
@@ -149,7 +187,10 @@ fn trait_arc_agrees_with_3d_arc() {
                 let a2 = arc.thickness(tooth, 2.0, phi);
                 // the 3-D ray is the effective edge at φ + δ_i: |m f (sin(φ+δ) − sin φ)| ≤ K f |δ|
                 let tol = 1e-12 + 4.0 * fz * delta_max;
-                assert!((a3 - a2).abs() <= tol, "ρ {rho} tooth {tooth} φ {phi}: {a3} {a2}");
+                assert!(
+                    (a3 - a2).abs() <= tol,
+                    "ρ {rho} tooth {tooth} φ {phi}: {a3} {a2}"
+                );
             }
         }
     }
@@ -178,10 +219,23 @@ fn exact_approaches_arc_for_tiny_feed() {
 
 #[test]
 fn equivalent_trait_equals_general_model() {
-    let cutter = Cutter::new(12.0, vec![deg(80.0), deg(100.0), deg(80.0), deg(100.0)], 40.0, 30.0, RadiusProfile::Flat)
-        .unwrap();
+    let cutter = Cutter::new(
+        12.0,
+        vec![deg(80.0), deg(100.0), deg(80.0), deg(100.0)],
+        40.0,
+        30.0,
+        RadiusProfile::Flat,
+    )
+    .unwrap();
     let runout = Runout::new(0.015, deg(130.0)).unwrap();
-    for params in [EquivalentParams::default(), EquivalentParams { k1: 0.95, k2: 0.9, phase_refinement: false }] {
+    for params in [
+        EquivalentParams::default(),
+        EquivalentParams {
+            k1: 0.95,
+            k2: 0.9,
+            phase_refinement: false,
+        },
+    ] {
         let fast = EquivalentChip::new(&cutter, &runout, 0.08, params).unwrap();
         let kin = straight_kin(&cutter, &runout, 0.08);
         for z in [0.0, 7.0] {
@@ -209,7 +263,11 @@ fn fitted_compensation_improves_on_analytic() {
     let fit = fit_compensation(&kin, &calib, false).unwrap();
     assert!(fit.condition < 1e3, "{}", fit.condition);
     // a second-order model: the k's stay near their analytic value 1
-    assert!((fit.params.k1 - 1.0).abs() < 0.2 && (fit.params.k2 - 1.0).abs() < 0.2, "{:?}", fit.params);
+    assert!(
+        (fit.params.k1 - 1.0).abs() < 0.2 && (fit.params.k2 - 1.0).abs() < 0.2,
+        "{:?}",
+        fit.params
+    );
     // on an independent grid the fitted model is no worse than k = 1 (pooled metric)
     let pts = sample_grid(4, &[1.0, 5.0], 0.013, 1.0, 90);
     let fitted = evaluate_models(&kin, &pts, &fit.params);
@@ -233,10 +291,18 @@ fn force_simulation_with_every_model() {
     // reference case of the force module (arc: 247.361 N); exact and equivalent differ from
     // the arc model only by the second-order chip terms, f/R = 0.016 → well below 2 %.
     let cutter = Cutter::flat(10.0, 4, 0.0).unwrap();
-    let cut = Cut::new(3240.0, 0.08, 1.0).unwrap().radial(2.0, MillingMode::Down, &cutter).unwrap();
+    let cut = Cut::new(3240.0, 0.08, 1.0)
+        .unwrap()
+        .radial(2.0, MillingMode::Down, &cutter)
+        .unwrap();
     let k = CuttingCoefficients::new([1889.2, 806.1, 291.0], [63.12, 113.7, -3.1]).unwrap();
     let runout = Runout::new(0.008, 0.0).unwrap();
-    let model = ForceModel { cutter: cutter.clone(), runout, cut, coefficients: k };
+    let model = ForceModel {
+        cutter: cutter.clone(),
+        runout,
+        cut,
+        coefficients: k,
+    };
     let sampling = Sampling::new(1.0, 0.25, 1).unwrap();
     let peak = |s: &ForceSeries| s.fxy().into_iter().fold(0.0, f64::max);
     let arc = model.simulate(&ArcChip::new(&cutter, &runout, 0.08).unwrap(), &sampling);
@@ -293,5 +359,93 @@ proptest! {
         let eq_tol = 2.0 * d * d * d / (r * r) + 1e-12;
         prop_assert!((c.equivalent.max(0.0) - e.h()).abs() <= eq_tol,
             "eq {} exact {} tol {}", c.equivalent, e.h(), eq_tol);
+    }
+}
+
+#[test]
+fn small_sin_cos_matches_libm() {
+    // Taylor degree 15/16 (or 9/10 below 1/8): truncation < 1e-19, so only rounding remains
+    for q in -2000..=2000 {
+        let x = q as f64 * 3.1e-4; // |x| ≤ 0.62 (also exercises the libm fallback above 0.5)
+        let (s, c) = runout_core::chip::kinematics::small_sin_cos(x);
+        assert!(
+            (s - x.sin()).abs() < 3e-16 && (c - x.cos()).abs() < 3e-16,
+            "{x}"
+        );
+    }
+}
+
+#[test]
+fn straight_feed_exact_solvers_agree_on_general_cutters() {
+    // scalar exact (trait path) vs 3-D Newton: variable pitch, tilt, ball / bull-nose profiles
+    let pitch = vec![deg(85.0), deg(95.0), deg(85.0), deg(95.0)];
+    let cutters = [
+        Cutter::new(10.0, pitch.clone(), 35.0, 30.0, RadiusProfile::Ball).unwrap(),
+        Cutter::new(
+            10.0,
+            pitch,
+            20.0,
+            30.0,
+            RadiusProfile::BullNose { corner_mm: 1.5 },
+        )
+        .unwrap(),
+    ];
+    let runout = Runout::new(0.012, deg(-30.0))
+        .unwrap()
+        .with_tilt(3e-4, deg(60.0))
+        .unwrap();
+    for cutter in &cutters {
+        let exact = ExactChip::new(cutter, &runout, 0.06).unwrap();
+        let kin = exact.kinematics();
+        for z in [0.3, 1.0, 4.0, 8.0] {
+            let ev = exact.at_height(z);
+            for tooth in 0..4 {
+                for q in 0..48 {
+                    let phi = deg(7.5 * q as f64 + 0.2);
+                    let (s, c) = phi.sin_cos();
+                    let t = kin.time_at_tooth_angle(tooth, z, phi);
+                    let e3 = exact_iuct(&kin, tooth, z, t, &NewtonOptions::default());
+                    assert!(e3.converged);
+                    // both converged to 1e-12 mm; rounding of the different algebra ~1e-14
+                    assert!(
+                        (ev.thickness(tooth, phi, s, c) - e3.h()).abs() < 1e-11,
+                        "z {z} tooth {tooth} φ {phi}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn circular_feed_of_large_radius_approaches_straight_feed() {
+    // a circle of radius r_c bends the feed by f/r_c per tooth: the chip differs from straight
+    // feed by O(h·(R/r_c)) — below 0.3 % of f for r_c = 5 m
+    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let runout = Runout::new(0.01, deg(40.0)).unwrap();
+    let fz = 0.1;
+    let speed = fz * 4.0 * 6000.0 / 60.0;
+    let straight = ToolKinematics::new(
+        &cutter,
+        &runout,
+        6000.0,
+        0.0,
+        SpindleSense::Clockwise,
+        StraightFeed::along_x(speed),
+    )
+    .unwrap();
+    // centre below the path so that at α = 90° the tip moves along +x (clockwise circle)
+    let mut circ = CircularFeed::new(Vec3::new(0.0, -5000.0, 0.0), 5000.0, speed, false).unwrap();
+    circ.start_angle = std::f64::consts::FRAC_PI_2;
+    let circular =
+        ToolKinematics::new(&cutter, &runout, 6000.0, 0.0, SpindleSense::Clockwise, circ).unwrap();
+    let opts = NewtonOptions::default();
+    for tooth in 0..4 {
+        for q in 0..36 {
+            let t = 0.01 + 0.01 * q as f64 / 36.0;
+            let a = exact_iuct(&straight, tooth, 2.0, t, &opts).h();
+            let b = exact_iuct(&circular, tooth, 2.0, t, &opts).h();
+            assert!((a - b).abs() < 3e-3 * fz, "{a} {b}");
+        }
     }
 }

@@ -6,18 +6,37 @@ use std::f64::consts::TAU;
 
 /// The kinematics of methods.md App. A.3 `Cut(...)`: CCW spindle, e₁ = +x, feed +x, swing
 /// Ω about `w` through the tip.
-fn app_a3(r: f64, k: usize, fz: f64, rho: f64, omega_swing: f64, w: Vec3) -> ToolKinematics<Motion> {
+fn app_a3(
+    r: f64,
+    k: usize,
+    fz: f64,
+    rho: f64,
+    omega_swing: f64,
+    w: Vec3,
+) -> ToolKinematics<Motion> {
     let cutter = Cutter::flat(2.0 * r, k, 30.0).unwrap();
     let runout = Runout::new(rho, 40f64.to_radians()).unwrap();
     let v = Vec3::new(fz * k as f64 * 100.0, 0.0, 0.0); // 6000 rpm: T = 0.01 s
     let motion = if omega_swing == 0.0 {
-        Motion::Straight(StraightFeed { p0: Vec3::zeros(), v, u: Vec3::z(), e1: Vec3::x() })
+        Motion::Straight(StraightFeed {
+            p0: Vec3::zeros(),
+            v,
+            u: Vec3::z(),
+            e1: Vec3::x(),
+        })
     } else {
         let s = ConstantSwing::new(v, w, omega_swing, 0.0).unwrap();
         Motion::Swing(ConstantSwing { e1: Vec3::x(), ..s })
     };
-    ToolKinematics::new(&cutter, &runout, 6000.0, 0.0, SpindleSense::CounterClockwise, motion)
-        .unwrap()
+    ToolKinematics::new(
+        &cutter,
+        &runout,
+        6000.0,
+        0.0,
+        SpindleSense::CounterClockwise,
+        motion,
+    )
+    .unwrap()
 }
 
 use runout_core::chip::compare::Motion;
@@ -26,14 +45,21 @@ use runout_core::chip::compare::Motion;
 fn methods_section7_vectors() {
     // Reference values of methods.md §7 are printed to 3 decimals in µm: tolerance 0.5 nm.
     let kin = app_a3(5.0, 4, 0.1, 0.010, 0.0, Vec3::y());
-    for (frac, ex, arc, eq) in [(5.0, 92.987, 93.039, 93.146), (10.0, 68.603, 67.631, 68.711)] {
+    for (frac, ex, arc, eq) in [
+        (5.0, 92.987, 93.039, 93.146),
+        (10.0, 68.603, 67.631, 68.711),
+    ] {
         let t = 0.01 * (1.0 + frac / 48.0);
         let e = exact_iuct(&kin, 0, 5.0, t, &NewtonOptions::default());
         let c = closed_forms(&kin, 0, 5.0, t, &EquivalentParams::analytic_unrefined());
         assert!(e.converged);
         assert!((e.h() * 1e3 - ex).abs() < 5e-4, "exact {}", e.h() * 1e3);
         assert!((c.arc * 1e3 - arc).abs() < 5e-4, "arc {}", c.arc * 1e3);
-        assert!((c.equivalent * 1e3 - eq).abs() < 5e-4, "eq {}", c.equivalent * 1e3);
+        assert!(
+            (c.equivalent * 1e3 - eq).abs() < 5e-4,
+            "eq {}",
+            c.equivalent * 1e3
+        );
         // the phase refinement (§2.4) must move the equivalent value towards the exact one
         let r = closed_forms(&kin, 0, 5.0, t, &EquivalentParams::default());
         assert!((r.equivalent - e.h()).abs() < (c.equivalent - e.h()).abs());
@@ -75,7 +101,11 @@ impl Brute {
         let q = rot(self.w, self.swing * t);
         let u = [q[0][2], q[1][2], q[2][2]];
         let e1 = [q[0][0], q[1][0], q[2][0]];
-        let e2 = [u[1] * e1[2] - u[2] * e1[1], u[2] * e1[0] - u[0] * e1[2], u[0] * e1[1] - u[1] * e1[0]];
+        let e2 = [
+            u[1] * e1[2] - u[2] * e1[1],
+            u[2] * e1[0] - u[0] * e1[2],
+            u[0] * e1[1] - u[1] * e1[0],
+        ];
         (u, e1, e2)
     }
     fn axis(&self, z: f64, t: f64) -> [f64; 3] {
@@ -124,7 +154,11 @@ impl Brute {
         let ri = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
         let n = [r[0] / ri, r[1] / ri, r[2] / ri];
         // side of the ray: component along u × n
-        let side = [u[1] * n[2] - u[2] * n[1], u[2] * n[0] - u[0] * n[2], u[0] * n[1] - u[1] * n[0]];
+        let side = [
+            u[1] * n[2] - u[2] * n[1],
+            u[2] * n[0] - u[0] * n[2],
+            u[0] * n[1] - u[1] * n[0],
+        ];
         let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         let period = TAU / self.om;
         let mut best = f64::NEG_INFINITY;
@@ -210,6 +244,22 @@ fn exact_matches_brute_force_3axis() {
 
 #[test]
 fn exact_matches_brute_force_5axis_swing() {
-    check_against_brute(5.0, 4, 0.1, 0.010, 60f64.to_radians(), Vec3::y(), &[0.0, 10.0, 20.0]);
-    check_against_brute(5.0, 4, 0.1, 0.010, 60f64.to_radians(), Vec3::new(1.0, 0.3, 0.0), &[10.0]);
+    check_against_brute(
+        5.0,
+        4,
+        0.1,
+        0.010,
+        60f64.to_radians(),
+        Vec3::y(),
+        &[0.0, 10.0, 20.0],
+    );
+    check_against_brute(
+        5.0,
+        4,
+        0.1,
+        0.010,
+        60f64.to_radians(),
+        Vec3::new(1.0, 0.3, 0.0),
+        &[10.0],
+    );
 }

@@ -251,9 +251,19 @@ impl Apt<'_> {
         let v = self.numbers(line, "GOTO", args)?;
         let axis = match v.len() {
             3 if !self.multax => [0.0, 0.0, 1.0],
-            3 => return Err(self.err(line, "GOTO: MULTAX is on, expected x,y,z,i,j,k (6 values), got 3")),
+            3 => {
+                return Err(self.err(
+                    line,
+                    "GOTO: MULTAX is on, expected x,y,z,i,j,k (6 values), got 3",
+                ))
+            }
             6 => [v[3], v[4], v[5]],
-            n => return Err(self.err(line, format!("GOTO: expected x,y,z or x,y,z,i,j,k, got {n} values"))),
+            n => {
+                return Err(self.err(
+                    line,
+                    format!("GOTO: expected x,y,z or x,y,z,i,j,k, got {n} values"),
+                ))
+            }
         };
         let axis = unit_axis(self.file, line, axis, &mut self.path.warnings)?;
         self.path.points.push(ToolpathPoint {
@@ -324,7 +334,10 @@ pub fn parse_cl_csv(file: &str, text: &str) -> Result<Toolpath, ToolpathError> {
         let first_is_text = fields[0].parse::<f64>().is_err();
         if path.points.is_empty() && first_is_text {
             let ok = (6..=7).contains(&fields.len())
-                && fields.iter().zip(HEADER).all(|(f, h)| f.eq_ignore_ascii_case(h));
+                && fields
+                    .iter()
+                    .zip(HEADER)
+                    .all(|(f, h)| f.eq_ignore_ascii_case(h));
             if !ok {
                 return Err(err(
                     line,
@@ -336,7 +349,10 @@ pub fn parse_cl_csv(file: &str, text: &str) -> Result<Toolpath, ToolpathError> {
         if !(6..=7).contains(&fields.len()) {
             return Err(err(
                 line,
-                format!("expected 6 or 7 fields (x_mm,y_mm,z_mm,i,j,k[,feed_mm_min]), got {}", fields.len()),
+                format!(
+                    "expected 6 or 7 fields (x_mm,y_mm,z_mm,i,j,k[,feed_mm_min]), got {}",
+                    fields.len()
+                ),
             ));
         }
         let mut v = [0.0; 7];

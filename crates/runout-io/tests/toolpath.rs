@@ -69,10 +69,13 @@ fn parse_err(e: ToolpathError) -> (usize, String) {
 
 #[test]
 fn malformed_apt_lines_name_the_line() {
-    let (line, msg) = parse_err(parse_apt("x.apt", "MULTAX\nGOTO/0,0,0,0,0,1\nGOTO/1,0,abc,0,0,1\n").unwrap_err());
+    let (line, msg) = parse_err(
+        parse_apt("x.apt", "MULTAX\nGOTO/0,0,0,0,0,1\nGOTO/1,0,abc,0,0,1\n").unwrap_err(),
+    );
     assert_eq!(line, 3);
     assert!(msg.contains("abc"), "{msg}");
-    let (line, msg) = parse_err(parse_apt("x.apt", "MULTAX\nGOTO/0,0,0,0,0,1\n$$ c\nGOTO/1,0,0\n").unwrap_err());
+    let (line, msg) =
+        parse_err(parse_apt("x.apt", "MULTAX\nGOTO/0,0,0,0,0,1\n$$ c\nGOTO/1,0,0\n").unwrap_err());
     assert_eq!(line, 4);
     assert!(msg.contains("6 values"), "{msg}");
     let (line, _) = parse_err(parse_apt("x.apt", "GOTO/1,2,3,4\n").unwrap_err());
@@ -80,7 +83,8 @@ fn malformed_apt_lines_name_the_line() {
     let (line, msg) = parse_err(parse_apt("x.apt", "GOTO/0,0,0\nFEDRAT/MMPR,0.1\n").unwrap_err());
     assert_eq!(line, 2);
     assert!(msg.contains("per revolution"));
-    let (line, _) = parse_err(parse_apt("x.apt", "GOTO/0,0,0\nCIRCLE/0,0,0,0,0,1,5\n").unwrap_err());
+    let (line, _) =
+        parse_err(parse_apt("x.apt", "GOTO/0,0,0\nCIRCLE/0,0,0,0,0,1,5\n").unwrap_err());
     assert_eq!(line, 2);
     // the error message names file and line
     let e = parse_apt("part.apt", "\n\nGOTO/1,,2\n").unwrap_err();
@@ -89,14 +93,16 @@ fn malformed_apt_lines_name_the_line() {
 
 #[test]
 fn zero_axis_is_an_error_non_unit_is_normalised_with_warning() {
-    let (line, msg) = parse_err(parse_apt("z.apt", "MULTAX\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0,0,0,0\n").unwrap_err());
+    let (line, msg) =
+        parse_err(parse_apt("z.apt", "MULTAX\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0,0,0,0\n").unwrap_err());
     assert_eq!(line, 3);
     assert!(msg.contains("zero length"));
     let p = parse_apt("n.apt", "MULTAX\nGOTO/0,0,0,0,3,4\n").unwrap();
     assert_eq!(p.warnings.len(), 1);
     assert!(p.warnings[0].contains("n.apt:2") && p.warnings[0].contains("normalised"));
     assert!((p.points[0].axis[1] - 0.6).abs() < 1e-15 && (p.points[0].axis[2] - 0.8).abs() < 1e-15);
-    let (line, _) = parse_err(parse_cl_csv("z.csv", "0,0,0,0,0,1,100\n1,0,0,0,0,0,100\n").unwrap_err());
+    let (line, _) =
+        parse_err(parse_cl_csv("z.csv", "0,0,0,0,0,1,100\n1,0,0,0,0,0,100\n").unwrap_err());
     assert_eq!(line, 2);
 }
 

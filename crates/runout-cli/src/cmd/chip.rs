@@ -6,8 +6,8 @@ use crate::output;
 use anyhow::{bail, Result};
 use runout_core::angle::wrap_tau;
 use runout_core::chip::compare::{
-    arc_values, equivalent_values, evaluate_models, exact_values, ErrorAccumulator,
-    ErrorMetrics, ModelValues, SamplePoint,
+    arc_values, equivalent_values, evaluate_models, exact_values, ErrorAccumulator, ErrorMetrics,
+    ModelValues, SamplePoint,
 };
 use runout_core::chip::{
     arc_at, calibration_grid, closed_forms_at, equivalent_at, exact_at, fit_compensation,
@@ -100,7 +100,11 @@ fn select(cases: Vec<ChipCase>, filter: Option<&str>, file: &Path) -> Result<Vec
         None => cases,
     };
     if chosen.is_empty() {
-        bail!("{}: no case matches --case {:?}", file.display(), filter.unwrap_or(""));
+        bail!(
+            "{}: no case matches --case {:?}",
+            file.display(),
+            filter.unwrap_or("")
+        );
     }
     Ok(chosen)
 }
@@ -125,7 +129,10 @@ struct CaseResult {
     fit: Option<runout_core::chip::CompensationFit>,
 }
 
-fn fitted_values(case: &ChipCase, params: &EquivalentParams) -> Result<(Vec<f64>, runout_core::chip::CompensationFit)> {
+fn fitted_values(
+    case: &ChipCase,
+    params: &EquivalentParams,
+) -> Result<(Vec<f64>, runout_core::chip::CompensationFit)> {
     let kin = &case.kin;
     let t0 = case.points.first().map(|p| p.t).unwrap_or(0.0);
     let calib = calibration_grid(kin, &case.spec.heights_mm, 12, t0);
@@ -143,8 +150,11 @@ fn compare_case(
     let kin = &case.kin;
     let pts = &case.points;
     let v: ModelValues = evaluate_models(kin, pts, params);
-    let models: [(&'static str, &Vec<f64>); 3] =
-        [("arc", &v.arc), ("circle", &v.circle), ("equivalent", &v.equivalent)];
+    let models: [(&'static str, &Vec<f64>); 3] = [
+        ("arc", &v.arc),
+        ("circle", &v.circle),
+        ("equivalent", &v.equivalent),
+    ];
     let mut metrics = Vec::new();
     for (q, (name, vals)) in models.iter().enumerate() {
         let mut acc = ErrorAccumulator::default();
@@ -194,11 +204,16 @@ fn compare(a: CompareArgs) -> Result<()> {
     }
     let names = ["arc", "circle", "equivalent", "equivalent_fitted_k"];
     let n_models = if a.fit_k { 4 } else { 3 };
-    let pooled: Vec<(&str, ErrorMetrics)> =
-        (0..n_models).map(|q| (names[q], pooled[q].metrics())).collect();
+    let pooled: Vec<(&str, ErrorMetrics)> = (0..n_models)
+        .map(|q| (names[q], pooled[q].metrics()))
+        .collect();
     let total_pts: usize = results.iter().map(|r| r.points).sum();
     let pooled_rate = |q: usize| {
-        total_pts as f64 / results.iter().map(|r| r.points as f64 / r.rates[q]).sum::<f64>()
+        total_pts as f64
+            / results
+                .iter()
+                .map(|r| r.points as f64 / r.rates[q])
+                .sum::<f64>()
     };
     let rates = [pooled_rate(0), pooled_rate(1), pooled_rate(2)];
     if let Some(j) = &a.json {
@@ -286,7 +301,14 @@ fn print_compare(
     let row = |name: &str, pts: String, ms: &[(&str, ErrorMetrics)]| {
         print!("{name:<34} {pts:>7}");
         for (_, m) in ms {
-            print!(" {:>22}", format!("{:.3} / {:.3}", m.mean_relative * 100.0, m.normalised_mae * 100.0));
+            print!(
+                " {:>22}",
+                format!(
+                    "{:.3} / {:.3}",
+                    m.mean_relative * 100.0,
+                    m.normalised_mae * 100.0
+                )
+            );
         }
         println!();
     };
@@ -344,8 +366,11 @@ fn eval(a: EvalArgs) -> Result<()> {
     for out in [&a.out, &a.plot, &a.map, &a.json].into_iter().flatten() {
         output::check_not_input(out, &[a.config.as_path()])?;
     }
-    if !(a.plot_revolutions > 0.0) {
-        bail!("--plot-revolutions: expected a count > 0, got {}", a.plot_revolutions);
+    if a.plot_revolutions.is_nan() || a.plot_revolutions <= 0.0 {
+        bail!(
+            "--plot-revolutions: expected a count > 0, got {}",
+            a.plot_revolutions
+        );
     }
     for w in &case.warnings {
         eprintln!("warning: {w}");
@@ -413,7 +438,11 @@ fn plot_height(case: &ChipCase, want: Option<f64>) -> Result<f64> {
 fn angle_curves(case: &ChipCase, h: &[f64], z: f64, revs: f64) -> Vec<ToothCurve> {
     let kin = &case.kin;
     let t_end = case.points.first().map(|p| p.t).unwrap_or(0.0) + revs * kin.period();
-    let theta0 = case.points.first().map(|p| kin.spindle_angle(p.t)).unwrap_or(0.0);
+    let theta0 = case
+        .points
+        .first()
+        .map(|p| kin.spindle_angle(p.t))
+        .unwrap_or(0.0);
     let base = (wrap_tau(theta0) - theta0).to_degrees();
     (0..kin.cutter().teeth())
         .map(|tooth| ToothCurve {

@@ -49,7 +49,13 @@ pub struct SamplePoint {
 
 /// The grid: every tooth at every height at `samples` times evenly spread over
 /// [t0, t0 + span).
-pub fn sample_grid(teeth: usize, heights: &[f64], t0: f64, span: f64, samples: usize) -> Vec<SamplePoint> {
+pub fn sample_grid(
+    teeth: usize,
+    heights: &[f64],
+    t0: f64,
+    span: f64,
+    samples: usize,
+) -> Vec<SamplePoint> {
     let mut out = Vec::with_capacity(teeth * heights.len() * samples);
     for j in 0..samples {
         let t = t0 + span * j as f64 / samples as f64;

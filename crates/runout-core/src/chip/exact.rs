@@ -130,7 +130,13 @@ impl Ray {
 
     /// Axis displacement d = [A(z,t) − A(z,t+τ)]_⊥u since time t + τ (mm), eq. (2.4).
     #[inline]
-    pub fn displacement<M: ToolMotion>(&self, kin: &ToolKinematics<M>, z: f64, t: f64, tau: f64) -> Vec3 {
+    pub fn displacement<M: ToolMotion>(
+        &self,
+        kin: &ToolKinematics<M>,
+        z: f64,
+        t: f64,
+        tau: f64,
+    ) -> Vec3 {
         let d = self.origin - kin.axis_point(z, t + tau);
         d - self.axis * d.dot(&self.axis)
     }

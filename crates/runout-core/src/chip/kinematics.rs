@@ -691,8 +691,13 @@ impl<M: ToolMotion> ToolKinematics<M> {
                 tau_aligned.push(-gap + shift / self.omega);
             }
         }
-        let turn_aligned = tau_aligned.iter().map(|t| (t * self.omega).sin_cos()).collect();
-        let prev = (0..k * k).map(|q| (q / k + k * (q % k + 1) - (q % k + 1)) % k).collect();
+        let turn_aligned = tau_aligned
+            .iter()
+            .map(|t| (t * self.omega).sin_cos())
+            .collect();
+        let prev = (0..k * k)
+            .map(|q| (q / k + k * (q % k + 1) - (q % k + 1)) % k)
+            .collect();
         HeightGeometry {
             prev,
             turn_aligned,

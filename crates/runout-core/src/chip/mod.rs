@@ -15,18 +15,19 @@ mod straight;
 
 pub use arc::{ArcAtHeight, ArcChip};
 pub use closed_form::{
-    arc_at, arc_iuct, closed_forms, closed_forms_at, equivalent_at, equivalent_iuct, pass_terms, ClosedForms, EquivalentParams, PassTerms,
+    arc_at, arc_iuct, closed_forms, closed_forms_at, equivalent_at, equivalent_iuct, pass_terms,
+    ClosedForms, EquivalentParams, PassTerms,
 };
 pub use compensation::{calibration_grid, fit_compensation, CalibrationPoint, CompensationFit};
-pub use straight::{
-    straight_feed_kinematics, EquivalentAtHeight, EquivalentChip, ExactAtHeight, ExactChip,
-};
 pub use exact::{
     crossing_at, exact_at, exact_iuct, ray_crossing, ExactIuct, NewtonOptions, Ray, RayCrossing,
 };
 pub use kinematics::{
-    ClPath, ClPoint, CircularFeed, ConstantSwing, EdgeState, HeightGeometry, Pose, SpindlePoint, SpindleSense,
-    StraightFeed, ToolKinematics, ToolMotion, Vec3,
+    CircularFeed, ClPath, ClPoint, ConstantSwing, EdgeState, HeightGeometry, Pose, SpindlePoint,
+    SpindleSense, StraightFeed, ToolKinematics, ToolMotion, Vec3,
+};
+pub use straight::{
+    straight_feed_kinematics, EquivalentAtHeight, EquivalentChip, ExactAtHeight, ExactChip,
 };
 
 /// A chip-thickness model for steady 3-axis straight feed.

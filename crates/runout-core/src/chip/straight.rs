@@ -29,14 +29,7 @@ pub fn straight_feed_kinematics(
     positive("fz_mm", fz_mm)?;
     let feed_per_rev = fz_mm * cutter.teeth() as f64;
     let motion = StraightFeed::along_x(feed_per_rev * RPM / 60.0);
-    ToolKinematics::new(
-        cutter,
-        runout,
-        RPM,
-        0.0,
-        SpindleSense::Clockwise,
-        motion,
-    )
+    ToolKinematics::new(cutter, runout, RPM, 0.0, SpindleSense::Clockwise, motion)
 }
 
 /// Exact IUCT (methods.md eq. 2.2–2.3) in steady 3-axis straight feed.

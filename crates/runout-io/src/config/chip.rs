@@ -231,17 +231,26 @@ fn cutter_of(s: &ChipCaseSpec) -> Result<Cutter, String> {
         "bull_nose" => RadiusProfile::BullNose {
             corner_mm: s.corner_mm.ok_or("bull_nose needs corner_mm")?,
         },
-        o => return Err(format!("profile: expected flat, ball or bull_nose, got `{o}`")),
+        o => {
+            return Err(format!(
+                "profile: expected flat, ball or bull_nose, got `{o}`"
+            ))
+        }
     };
     let pitch = match &s.pitch_deg {
         Some(p) if p.len() != s.teeth => {
-            return Err(format!("pitch_deg: expected {} values, got {}", s.teeth, p.len()))
+            return Err(format!(
+                "pitch_deg: expected {} values, got {}",
+                s.teeth,
+                p.len()
+            ))
         }
         Some(p) => p.iter().map(|d| d.to_radians()).collect(),
         None if s.teeth == 0 => return Err("teeth: expected an integer >= 1".into()),
         None => vec![TAU / s.teeth as f64; s.teeth],
     };
-    Cutter::new(s.diameter_mm, pitch, s.helix_deg, f64::INFINITY, profile).map_err(|e| e.to_string())
+    Cutter::new(s.diameter_mm, pitch, s.helix_deg, f64::INFINITY, profile)
+        .map_err(|e| e.to_string())
 }
 
 fn runout_of(s: &ChipCaseSpec) -> Result<Runout, String> {
@@ -262,9 +271,14 @@ fn feed_speed(s: &ChipCaseSpec) -> Result<f64, String> {
 fn motion_of(s: &ChipCaseSpec, base: &Path) -> Result<(Motion, Vec<String>), String> {
     let along_x = |v: f64| Vec3::new(v, 0.0, 0.0);
     Ok(match s.motion.as_str() {
-        "straight" => (Motion::Straight(StraightFeed::along_x(feed_speed(s)?)), vec![]),
+        "straight" => (
+            Motion::Straight(StraightFeed::along_x(feed_speed(s)?)),
+            vec![],
+        ),
         "circular" => {
-            let r = s.path_radius_mm.ok_or("path_radius_mm: required for circular")?;
+            let r = s
+                .path_radius_mm
+                .ok_or("path_radius_mm: required for circular")?;
             let c = CircularFeed::new(Vec3::zeros(), r, feed_speed(s)?, s.path_ccw)
                 .map_err(|e| e.to_string())?;
             (Motion::Circular(c), vec![])
@@ -285,16 +299,26 @@ fn motion_of(s: &ChipCaseSpec, base: &Path) -> Result<(Motion, Vec<String>), Str
             let full = base.join(file);
             let mut tp = read_toolpath(&full).map_err(|e| e.to_string())?;
             let name = full.display().to_string();
-            let cl = tp.cl_points(&name, s.feed_mm_min).map_err(|e| e.to_string())?;
+            let cl = tp
+                .cl_points(&name, s.feed_mm_min)
+                .map_err(|e| e.to_string())?;
             let path = ClPath::new(&cl).map_err(|e| format!("{name}: {e}"))?;
             (Motion::Path(path), tp.warnings)
         }
-        o => return Err(format!("motion: expected straight, circular, swing or path, got `{o}`")),
+        o => {
+            return Err(format!(
+                "motion: expected straight, circular, swing or path, got `{o}`"
+            ))
+        }
     })
 }
 
 /// Resolve one spec (toolpaths relative to `base`).
-pub fn resolve_case(file: &str, base: &Path, spec: ChipCaseSpec) -> Result<ChipCase, ChipConfigError> {
+pub fn resolve_case(
+    file: &str,
+    base: &Path,
+    spec: ChipCaseSpec,
+) -> Result<ChipCase, ChipConfigError> {
     let err = |message: String| ChipConfigError::Case {
         file: file.into(),
         case: spec.name.clone(),
@@ -314,24 +338,35 @@ pub fn resolve_case(file: &str, base: &Path, spec: ChipCaseSpec) -> Result<ChipC
     };
     let kin = ToolKinematics::new(&cutter, &runout, spec.rpm, 0.0, sense, motion)
         .map_err(|e| err(e.to_string()))?;
-    if spec.heights_mm.is_empty() || spec.heights_mm.iter().any(|z| !(z.is_finite() && *z >= 0.0)) {
-        return Err(err("heights_mm: expected one or more heights >= 0 (mm)".into()));
+    if spec.heights_mm.is_empty()
+        || spec
+            .heights_mm
+            .iter()
+            .any(|z| !(z.is_finite() && *z >= 0.0))
+    {
+        return Err(err(
+            "heights_mm: expected one or more heights >= 0 (mm)".into()
+        ));
     }
-    if spec.samples_per_rev == 0 || !(spec.revolutions >= 0.0) {
-        return Err(err("samples_per_rev >= 1 and revolutions >= 0 expected".into()));
+    if spec.samples_per_rev == 0 || spec.revolutions.is_nan() || spec.revolutions < 0.0 {
+        return Err(err(
+            "samples_per_rev >= 1 and revolutions >= 0 expected".into()
+        ));
     }
     let period = kin.period();
     let t0 = spec.start_s.unwrap_or(period);
     let span = match (duration, spec.revolutions) {
-        (Some(d), r) if r == 0.0 => d - t0,
+        (Some(d), 0.0) => d - t0,
         (_, r) => r * period,
     };
-    if !(span > 0.0) {
+    if span.is_nan() || span <= 0.0 {
         return Err(err(format!(
             "nothing to sample: start {t0:.4} s, span {span:.4} s (path shorter than one revolution?)"
         )));
     }
-    let samples = ((span / period) * spec.samples_per_rev as f64).round().max(1.0) as usize;
+    let samples = ((span / period) * spec.samples_per_rev as f64)
+        .round()
+        .max(1.0) as usize;
     let points = sample_grid(cutter.teeth(), &spec.heights_mm, t0, span, samples);
     Ok(ChipCase {
         name: spec.name.clone(),

@@ -30,9 +30,10 @@ fn draw_angle<DB: DrawingBackend>(
 ) -> Result<(), String> {
     root.fill(&WHITE).map_err(e2s)?;
     let pts = curves.iter().flat_map(|c| c.points.iter());
-    let (x0, x1, hmax) = pts.fold((f64::INFINITY, f64::NEG_INFINITY, 0.0f64), |(a, b, h), p| {
-        (a.min(p.0), b.max(p.0), h.max(p.1))
-    });
+    let (x0, x1, hmax) = pts.fold(
+        (f64::INFINITY, f64::NEG_INFINITY, 0.0f64),
+        |(a, b, h), p| (a.min(p.0), b.max(p.0), h.max(p.1)),
+    );
     let (x0, x1) = if x0 < x1 { (x0, x1) } else { (0.0, 360.0) };
     let top = hmax.max(1e-9) * 1.25;
     let mut chart = ChartBuilder::on(root)
@@ -51,7 +52,10 @@ fn draw_angle<DB: DrawingBackend>(
     for c in curves {
         let col = colour(c.tooth);
         chart
-            .draw_series(LineSeries::new(c.points.iter().copied(), col.stroke_width(2)))
+            .draw_series(LineSeries::new(
+                c.points.iter().copied(),
+                col.stroke_width(2),
+            ))
             .map_err(e2s)?
             .label(format!("tooth {}", c.tooth))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2)));
@@ -109,7 +113,13 @@ fn draw_map<DB: DrawingBackend>(
     let (main, bar) = root.split_horizontally(980);
     let xe = edges(&map.time_s);
     let ye = edges(&map.height_mm);
-    let vmax = map.values.iter().flatten().copied().fold(0.0f64, f64::max).max(1e-12);
+    let vmax = map
+        .values
+        .iter()
+        .flatten()
+        .copied()
+        .fold(0.0f64, f64::max)
+        .max(1e-12);
     let mut chart = ChartBuilder::on(&main)
         .caption(title, ("sans-serif", 20))
         .margin(12)
@@ -182,5 +192,9 @@ fn viridis(v: f64) -> RGBColor {
     let i = (x.floor() as usize).min(A.len() - 2);
     let f = x - i as f64;
     let mix = |a: u8, b: u8| (a as f64 + f * (b as f64 - a as f64)).round() as u8;
-    RGBColor(mix(A[i].0, A[i + 1].0), mix(A[i].1, A[i + 1].1), mix(A[i].2, A[i + 1].2))
+    RGBColor(
+        mix(A[i].0, A[i + 1].0),
+        mix(A[i].1, A[i + 1].1),
+        mix(A[i].2, A[i + 1].2),
+    )
 }
