@@ -241,12 +241,18 @@ impl EquivalentChip {
     }
 }
 
-/// [`EquivalentChip`] at one height.
+/// [`EquivalentChip`] at one height: per (tooth, m) the coefficients of
+/// h_m = ΔR + D·s + [k₁D²/2R_p]·c² − [k₂D·a/R_p]·c·s, stored as structure-of-arrays so that the
+/// min over m is a short branch-free loop.
 #[derive(Debug, Clone)]
 pub struct EquivalentAtHeight {
-    geo: StraightHeight,
-    k1: f64,
-    k2: f64,
+    k: usize,
+    /// (cos δ_i, sin δ_i) per tooth.
+    shift: Vec<(f64, f64)>,
+    delta_r: Vec<f64>,
+    d: Vec<f64>,
+    circle: Vec<f64>,
+    trochoid: Vec<f64>,
 }
 
 impl ChipThickness for EquivalentChip {
@@ -255,16 +261,22 @@ impl ChipThickness for EquivalentChip {
         "equivalent"
     }
     fn at_height(&self, z: f64) -> EquivalentAtHeight {
+        let geo = StraightHeight::new(
+            &self.cutter,
+            &self.runout,
+            self.fz,
+            z,
+            self.params.phase_refinement,
+        );
+        let (k1, k2, a) = (self.params.k1, self.params.k2, geo.a);
+        let col = |f: &dyn Fn(&Pass) -> f64| geo.pass.iter().map(f).collect::<Vec<f64>>();
         EquivalentAtHeight {
-            geo: StraightHeight::new(
-                &self.cutter,
-                &self.runout,
-                self.fz,
-                z,
-                self.params.phase_refinement,
-            ),
-            k1: self.params.k1,
-            k2: self.params.k2,
+            k: geo.k,
+            shift: geo.shift.clone(),
+            delta_r: col(&|p| p.delta_r),
+            d: col(&|p| p.d),
+            circle: col(&|p| k1 * p.d * p.d * 0.5 * p.inv_r_prev),
+            trochoid: col(&|p| k2 * p.d * a * p.inv_r_prev),
         }
     }
 }
@@ -272,14 +284,16 @@ impl ChipThickness for EquivalentChip {
 impl ChipAtHeight for EquivalentAtHeight {
     #[inline]
     fn thickness(&self, tooth: usize, _phi: f64, sin_phi: f64, cos_phi: f64) -> f64 {
-        let (s, c) = self.geo.effective(tooth, sin_phi, cos_phi);
-        let a = self.geo.a;
+        let (cd, sd) = self.shift[tooth];
+        let s = sin_phi * cd + cos_phi * sd;
+        let c = cos_phi * cd - sin_phi * sd;
+        let (cc, cs) = (c * c, c * s);
+        let r = tooth * self.k..(tooth + 1) * self.k;
+        let (dr, d) = (&self.delta_r[r.clone()], &self.d[r.clone()]);
+        let (ci, tr) = (&self.circle[r.clone()], &self.trochoid[r]);
         let mut h = f64::INFINITY;
-        for p in self.geo.passes(tooth) {
-            let dt = p.d * c;
-            let circle = 0.5 * dt * dt * p.inv_r_prev;
-            let trochoid = dt * a * s * p.inv_r_prev;
-            h = h.min(p.delta_r + p.d * s + self.k1 * circle - self.k2 * trochoid);
+        for m in 0..dr.len() {
+            h = h.min(dr[m] + d[m] * s + ci[m] * cc - tr[m] * cs);
         }
         h.max(0.0)
     }
