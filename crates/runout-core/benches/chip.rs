@@ -3,12 +3,12 @@
 //! path used by the force simulation. Cases: R 5, K 4, helix 30°, f_z 0.1, ρ 10 µm (methods.md
 //! §2.5) in straight feed and with a 60°/s swing about y.
 //!
-//! Two measurements: criterion's wall time, and the thread's CPU time read from
-//! `/proc/thread-self/schedstat` (Linux) — the "per core" figure, robust to other processes
-//! sharing the cores. A final summary prints points/s of every model and the speed ratios,
-//! all from this one run.
+//! Two measurements: criterion's wall time, and a final summary with the thread's CPU time read
+//! from `/proc/thread-self/schedstat` (Linux; tick resolution, hence ≥ 200 ms windows, best of
+//! 5) — the "per core" figure, robust to other processes sharing the cores. The summary prints
+//! points/s of every model, the speed ratios and a libm `sin_cos` baseline, all from this run.
 
-use criterion::measurement::{Measurement, ValueFormatter, WallTime};
+use criterion::measurement::{Measurement, WallTime};
 use criterion::{BenchmarkGroup, Criterion, Throughput};
 use runout_core::chip::compare::{
     arc_values, equivalent_values, exact_values, sample_grid, Motion, SamplePoint,
@@ -28,60 +28,6 @@ fn thread_cpu_ns() -> u64 {
             static T0: OnceLock<Instant> = OnceLock::new();
             T0.get_or_init(Instant::now).elapsed().as_nanos() as u64
         })
-}
-
-/// Criterion measurement: thread CPU time.
-struct CpuTime;
-struct NsFormatter;
-
-impl ValueFormatter for NsFormatter {
-    fn scale_values(&self, typical: f64, values: &mut [f64]) -> &'static str {
-        let (d, u) = if typical < 1e3 {
-            (1.0, "ns")
-        } else if typical < 1e6 {
-            (1e3, "µs")
-        } else if typical < 1e9 {
-            (1e6, "ms")
-        } else {
-            (1e9, "s")
-        };
-        values.iter_mut().for_each(|v| *v /= d);
-        u
-    }
-    fn scale_throughputs(&self, _typical: f64, t: &Throughput, values: &mut [f64]) -> &'static str {
-        let n = match t {
-            Throughput::Elements(n) => *n as f64,
-            _ => 1.0,
-        };
-        values.iter_mut().for_each(|v| *v = n * 1e9 / *v / 1e6);
-        "Melem/s (CPU)"
-    }
-    fn scale_for_machines(&self, _values: &mut [f64]) -> &'static str {
-        "ns"
-    }
-}
-
-impl Measurement for CpuTime {
-    type Intermediate = u64;
-    type Value = u64;
-    fn start(&self) -> u64 {
-        thread_cpu_ns()
-    }
-    fn end(&self, i: u64) -> u64 {
-        thread_cpu_ns().saturating_sub(i)
-    }
-    fn add(&self, a: &u64, b: &u64) -> u64 {
-        a + b
-    }
-    fn zero(&self) -> u64 {
-        0
-    }
-    fn to_f64(&self, v: &u64) -> f64 {
-        *v as f64
-    }
-    fn formatter(&self) -> &dyn ValueFormatter {
-        &NsFormatter
-    }
 }
 
 fn kin(motion: Motion) -> ToolKinematics<Motion> {
@@ -233,10 +179,6 @@ fn summary() {
 fn main() {
     let mut wall: Criterion<WallTime> = Criterion::default().configure_from_args();
     all(&mut wall, "wall");
-    let mut cpu = Criterion::default()
-        .with_measurement(CpuTime)
-        .configure_from_args();
-    all(&mut cpu, "cpu");
     summary();
     wall.final_summary();
 }

@@ -150,6 +150,14 @@ fn compare_case(
     let kin = &case.kin;
     let pts = &case.points;
     let v: ModelValues = evaluate_models(kin, pts, params);
+    if v.unconverged > 0 {
+        eprintln!(
+            "warning: case `{}`: the exact solver missed 1e-12 mm at {} of {} points",
+            case.name,
+            v.unconverged,
+            pts.len()
+        );
+    }
     let models: [(&'static str, &Vec<f64>); 3] = [
         ("arc", &v.arc),
         ("circle", &v.circle),
@@ -350,7 +358,18 @@ fn eval_model(case: &ChipCase, model: &str) -> Result<Vec<f64>> {
         }
         let g = geo.as_ref().expect("set above");
         let h = match model {
-            "exact" => exact_at(kin, g, q.tooth, q.t, &opts).raw,
+            "exact" => {
+                let e = exact_at(kin, g, q.tooth, q.t, &opts);
+                if !e.converged {
+                    bail!(
+                        "exact solver did not converge (tooth {}, z {} mm, t {} s)",
+                        q.tooth,
+                        q.z,
+                        q.t
+                    );
+                }
+                e.raw
+            }
             "equivalent" => equivalent_at(kin, g, q.tooth, q.t, &params),
             "arc" => arc_at(kin, g, q.tooth, q.t),
             "circle" => closed_forms_at(kin, g, q.tooth, q.t, &params).circle,

@@ -79,6 +79,8 @@ pub struct ModelValues {
     pub circle: Vec<f64>,
     /// Equivalent, eq. (2.8).
     pub equivalent: Vec<f64>,
+    /// Points where the exact Newton solve missed its tolerance (should be 0).
+    pub unconverged: usize,
 }
 
 /// Height geometries of the distinct heights of `points` (looked up by exact equality).
@@ -110,7 +112,9 @@ pub fn evaluate_models<M: ToolMotion>(
     let mut v = ModelValues::default();
     for q in points {
         let geo = heights.get(q.z);
-        v.exact.push(exact_at(kin, geo, q.tooth, q.t, &opts).h());
+        let e = exact_at(kin, geo, q.tooth, q.t, &opts);
+        v.unconverged += usize::from(!e.converged);
+        v.exact.push(e.h());
         let c = closed_forms_at(kin, geo, q.tooth, q.t, params);
         v.arc.push(c.arc.max(0.0));
         v.circle.push(c.circle.max(0.0));
