@@ -146,6 +146,8 @@ impl Ray {
 /// R_p sin ψ + (a·t̂)ψ = d·t̂, from ψ₀ = d·t̂/(R_p + a·t̂) (eq. 2.7) refined by two scalar Newton
 /// steps, then s = R_p cos ψ − d·n + ψ a·n. For straight feed this is already the exact crossing,
 /// so the 3-D Newton below converges in one step; otherwise it is a third-order start.
+/// Returns the start x and (sin ψ, cos ψ) (the last step δ is applied to them to first order:
+/// |δ| ≲ 1e-9 rad after the first step, so the neglected δ²/2 is below 1e-18).
 #[inline]
 fn start_point<M: ToolMotion>(
     kin: &ToolKinematics<M>,
@@ -154,18 +156,19 @@ fn start_point<M: ToolMotion>(
     t: f64,
     tau0: f64,
     r_prev: f64,
-) -> [f64; 3] {
+) -> ([f64; 3], (f64, f64)) {
     let d = ray.displacement(kin, z, t, tau0);
     let dt = d.dot(&ray.tangent);
     let at = ray.axis_rate.dot(&ray.tangent);
     let mut psi = dt / (r_prev + at);
-    for _ in 0..2 {
-        let (sn, cs) = small_sin_cos(psi);
-        psi -= (r_prev * sn + at * psi - dt) / (r_prev * cs + at);
-    }
-    let cs = small_sin_cos(psi).1;
+    let (mut sn, mut cs) = small_sin_cos(psi);
+    psi -= (r_prev * sn + at * psi - dt) / (r_prev * cs + at);
+    (sn, cs) = small_sin_cos(psi);
+    let step = (r_prev * sn + at * psi - dt) / (r_prev * cs + at);
+    psi -= step;
+    (sn, cs) = (sn - cs * step, cs + sn * step);
     let s = r_prev * cs - d.dot(&ray.dir) + psi * ray.axis_rate.dot(&ray.dir);
-    [tau0 + psi * kin.inv_omega(), z, s]
+    ([tau0 + psi * kin.inv_omega(), z, s], (sn, cs))
 }
 
 /// Newton solve of eq. (2.3) for the previous tooth m passes before `tooth` on height `geo`.
@@ -185,7 +188,7 @@ pub fn crossing_at<M: ToolMotion>(
     let r_prev = geo.radius[prev];
     let idx = geo.pass_index(tooth, m);
     let tau0 = geo.tau_aligned[idx];
-    let mut x = start_point(kin, ray, z, t, tau0, r_prev);
+    let (mut x, mut turn) = start_point(kin, ray, z, t, tau0, r_prev);
     // sin/cos of Θ(t + τ₀) by the addition theorem; the Newton iterates differ from τ₀ by a
     // small angle ε = ω(τ − τ₀) whose sin/cos come from `small_sin_cos` (no libm in the loop)
     let (sa, ca) = geo.turn_aligned[idx];
@@ -203,7 +206,10 @@ pub fn crossing_at<M: ToolMotion>(
         } else {
             kin.spindle_point(prev, x[1])
         };
-        let (se, ce) = small_sin_cos(kin.omega() * (x[0] - tau0));
+        if iterations > 1 {
+            turn = small_sin_cos(kin.omega() * (x[0] - tau0));
+        }
+        let (se, ce) = turn;
         let pose = kin.motion().pose(t + x[0]);
         let st = kin.edge_from_pose_sc(&pose, &sp, x[1], sb * ce + cb * se, cb * ce - sb * se);
         let f = st.pos - ray.origin - ray.dir * x[2];
