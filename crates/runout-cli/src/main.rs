@@ -20,12 +20,14 @@ struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
-#[allow(clippy::large_enum_variant)] // parsed once per run; boxing buys nothing
+#[allow(clippy::large_enum_variant)] // argument structs, parsed once
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
     Simulate(cmd::simulate::Args),
     /// Chip thickness with runout (exact, arc, equivalent models; 3-axis and 5-axis toolpaths).
     Chip(cmd::chip::Args),
+    /// Tool grinding: compensate the bar clamping error (probe grid → wheel path / NC program).
+    Grind(cmd::grind::Args),
 }
 
 fn main() -> ExitCode {
@@ -33,6 +35,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Chip(a) => cmd::chip::run(a),
+        Command::Grind(a) => cmd::grind::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
