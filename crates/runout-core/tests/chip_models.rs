@@ -449,3 +449,49 @@ fn circular_feed_of_large_radius_approaches_straight_feed() {
         }
     }
 }
+
+#[test]
+fn compensation_fit_round_trip_recovers_known_k() {
+    // targets from eq. (2.8) with known (k₁, k₂) plus Gaussian noise σ = 0.05 µm → the fit must
+    // recover them within 4 standard errors, and the standard errors must be consistent with σ
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+    let cutter = Cutter::flat(6.0, 4, 30.0).unwrap();
+    let runout = Runout::new(0.010, deg(40.0)).unwrap();
+    let kin = straight_kin(&cutter, &runout, 0.2);
+    let truth = EquivalentParams {
+        k1: 0.93,
+        k2: 1.08,
+        phase_refinement: true,
+    };
+    let calib = calibration_grid(&kin, &[0.0, 3.0], 45, 0.0);
+    let noise = Normal::new(0.0, 5e-5).unwrap();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    let targets: Vec<f64> = calib
+        .iter()
+        .map(|q| equivalent_iuct(&kin, q.tooth, q.z, q.t, &truth))
+        .map(|h| {
+            if h > 0.0 {
+                h + noise.sample(&mut rng)
+            } else {
+                h
+            }
+        })
+        .collect();
+    let fit = fit_compensation_to(&kin, &calib, &targets, true).unwrap();
+    for (got, want, se) in [
+        (fit.params.k1, truth.k1, fit.std_error[0]),
+        (fit.params.k2, truth.k2, fit.std_error[1]),
+    ] {
+        assert!(se > 0.0 && se < 0.05, "se {se}");
+        assert!((got - want).abs() < 4.0 * se, "{got} vs {want} ± {se}");
+    }
+    // residual ≈ σ (n ≈ 200: ±15 %)
+    assert!(
+        (fit.rms_residual_mm / 5e-5 - 1.0).abs() < 0.15,
+        "{}",
+        fit.rms_residual_mm
+    );
+    // wrong number of targets is a parameter error, not a panic
+    assert!(fit_compensation_to(&kin, &calib, &targets[1..], true).is_err());
+}

@@ -261,7 +261,9 @@ fn compare_json(
             "errors_vs_exact": models,
             "throughput_points_per_s": {"exact": r.rates[0], "equivalent": r.rates[1], "arc": r.rates[2]},
             "fitted_k": r.fit.map(|f| json!({
-                "k1": f.params.k1, "k2": f.params.k2, "condition": f.condition,
+                "k1": f.params.k1, "k2": f.params.k2,
+                "k1_std_error": f.std_error[0], "k2_std_error": f.std_error[1],
+                "condition": f.condition,
                 "rms_residual_um": f.rms_residual_mm * 1e3, "calibration_points": f.points,
             })),
         })
@@ -324,10 +326,12 @@ fn print_compare(
         row(&r.name, r.points.to_string(), &r.metrics);
         if let Some(f) = r.fit {
             println!(
-                "{:>42} fitted k1 = {:.4}, k2 = {:.4} (condition {:.1}, rms residual {:.4} µm)",
+                "{:>42} fitted k1 = {:.4} ± {:.4}, k2 = {:.4} ± {:.4} (standard errors; condition {:.1}, rms residual {:.4} µm)",
                 "",
                 f.params.k1,
+                f.std_error[0],
                 f.params.k2,
+                f.std_error[1],
                 f.condition,
                 f.rms_residual_mm * 1e3
             );

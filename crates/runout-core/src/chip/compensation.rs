@@ -29,6 +29,8 @@ pub struct CalibrationPoint {
 pub struct CompensationFit {
     /// Fitted parameters (with the phase-refinement flag used).
     pub params: EquivalentParams,
+    /// Standard errors of (k₁, k₂) from σ²(AᵀA)⁻¹, σ² = RSS/(n − 2).
+    pub std_error: [f64; 2],
     /// RMS of h_exact − h_eq at the calibration points (mm).
     pub rms_residual_mm: f64,
     /// Condition number σ_max/σ_min of the 2-column design matrix.
@@ -37,22 +39,44 @@ pub struct CompensationFit {
     pub points: usize,
 }
 
-/// Fit (k₁, k₂) on `points` (methods.md §2.4). Error when fewer than 3 cutting points or the two
-/// regressors are not separable (condition > 1e8).
+/// Fit (k₁, k₂) on `points` to the exact IUCT (methods.md §2.4). Error when fewer than 3 cutting
+/// points or the two regressors are not separable (condition > 1e8).
 pub fn fit_compensation<M: ToolMotion>(
     kin: &ToolKinematics<M>,
     points: &[CalibrationPoint],
     phase_refinement: bool,
 ) -> Result<CompensationFit, ParamError> {
     let opts = NewtonOptions::default();
+    let targets: Vec<f64> = points
+        .iter()
+        .map(|q| exact_at(kin, &kin.at_height(q.z), q.tooth, q.t, &opts).raw)
+        .collect();
+    fit_compensation_to(kin, points, &targets, phase_refinement)
+}
+
+/// Fit (k₁, k₂) of eq. (2.8) to given target thicknesses `targets[j]` (mm, raw: ≤ 0 = no cut,
+/// skipped) at `points[j]` — the least-squares core of [`fit_compensation`], also usable with
+/// measured or externally computed chip thicknesses.
+pub fn fit_compensation_to<M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    points: &[CalibrationPoint],
+    targets: &[f64],
+    phase_refinement: bool,
+) -> Result<CompensationFit, ParamError> {
+    if targets.len() != points.len() {
+        return Err(ParamError::new(
+            "targets",
+            format!("{} values (one per calibration point)", points.len()),
+            targets.len(),
+        ));
+    }
     let mut rows: Vec<[f64; 3]> = Vec::with_capacity(points.len());
-    for q in points {
-        let geo = kin.at_height(q.z);
-        let ray = Ray::at(kin, &geo, q.tooth, q.t);
-        let exact = exact_at(kin, &geo, q.tooth, q.t, &opts);
-        if exact.raw <= 0.0 {
+    for (q, &h) in points.iter().zip(targets) {
+        if h <= 0.0 {
             continue;
         }
+        let geo = kin.at_height(q.z);
+        let ray = Ray::at(kin, &geo, q.tooth, q.t);
         let active = (1..=kin.cutter().teeth())
             .map(|m| pass_terms(kin, &geo, &ray, q.tooth, m, q.t, phase_refinement))
             .min_by(|a, b| a.equivalent(1.0, 1.0).total_cmp(&b.equivalent(1.0, 1.0)))
@@ -60,9 +84,14 @@ pub fn fit_compensation<M: ToolMotion>(
         rows.push([
             active.circle_term(),
             active.trochoid_term(),
-            exact.raw - active.linear,
+            h - active.linear,
         ]);
     }
+    solve_rows(&rows, phase_refinement)
+}
+
+/// Least squares on rows [X₁, X₂, y] with the condition number and standard errors.
+fn solve_rows(rows: &[[f64; 3]], phase_refinement: bool) -> Result<CompensationFit, ParamError> {
     if rows.len() < 3 {
         return Err(ParamError::new(
             "calibration_points",
@@ -86,13 +115,21 @@ pub fn fit_compensation<M: ToolMotion>(
         ParamError::new("calibration_points", "a solvable least-squares problem", e)
     })?;
     let resid = &a * &k - &b;
+    let rss = resid.norm_squared();
+    // covariance σ²(AᵀA)⁻¹ with σ² = RSS/(n − 2)
+    let sigma2 = rss / (rows.len() as f64 - 2.0);
+    let cov = (a.transpose() * &a)
+        .try_inverse()
+        .map(|inv| inv * sigma2)
+        .unwrap_or_else(|| DMatrix::from_element(2, 2, f64::INFINITY));
     Ok(CompensationFit {
         params: EquivalentParams {
             k1: k[0],
             k2: k[1],
             phase_refinement,
         },
-        rms_residual_mm: (resid.norm_squared() / rows.len() as f64).sqrt(),
+        std_error: [cov[(0, 0)].sqrt(), cov[(1, 1)].sqrt()],
+        rms_residual_mm: (rss / rows.len() as f64).sqrt(),
         condition,
         points: rows.len(),
     })

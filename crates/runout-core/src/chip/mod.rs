@@ -18,7 +18,9 @@ pub use closed_form::{
     arc_at, arc_iuct, closed_forms, closed_forms_at, equivalent_at, equivalent_iuct, pass_terms,
     ClosedForms, EquivalentParams, PassTerms,
 };
-pub use compensation::{calibration_grid, fit_compensation, CalibrationPoint, CompensationFit};
+pub use compensation::{
+    calibration_grid, fit_compensation, fit_compensation_to, CalibrationPoint, CompensationFit,
+};
 pub use exact::{
     crossing_at, exact_at, exact_iuct, ray_crossing, ExactIuct, NewtonOptions, Ray, RayCrossing,
 };
