@@ -13,6 +13,7 @@ use criterion::{BenchmarkGroup, Criterion, Throughput};
 use runout_core::chip::compare::{
     arc_values, equivalent_values, exact_values, sample_grid, Motion, SamplePoint,
 };
+use runout_core::chip::kinematics::small_sin_cos;
 use runout_core::chip::*;
 use runout_core::{ArcChip, ChipAtHeight, ChipThickness, Cutter, Runout};
 use std::hint::black_box;
@@ -150,7 +151,15 @@ fn summary() {
     let sc = rate(xs.len(), || {
         xs.iter().map(|x| black_box(*x).sin_cos().0).sum()
     });
-    println!("  machine baseline: libm sin_cos {:.1} ns/call", 1e9 / sc);
+    let small: Vec<f64> = (0..4096).map(|q| (q as f64 - 2048.0) * 1e-4).collect();
+    let ss = rate(small.len(), || {
+        small.iter().map(|x| small_sin_cos(black_box(*x)).0).sum()
+    });
+    println!(
+        "  machine baseline: libm sin_cos {:.1} ns/call; small_sin_cos (|x| ≤ 0.2) {:.1} ns/call",
+        1e9 / sc,
+        1e9 / ss
+    );
     let pts = points();
     let params = EquivalentParams::default();
     for (name, k) in [("3-axis", kin(straight())), ("5-axis swing", kin(swing()))] {

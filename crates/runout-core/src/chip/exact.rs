@@ -3,7 +3,7 @@
 //!
 //! h_i(z,t) = max(0, R_i(z) − max_{m=1..K} s_m), where s_m solves
 //! E_{i−m}(z′, t + τ) − A(z,t) − s·n = 0 for x = (τ, z′, s) (τ = t′ − t), n = (E_i − A)/|E_i − A|.
-//! Jacobian J = [∂E/∂t, ∂E/∂z, −n] (see [`EdgeState`]); the 3×3 step is solved by Cramer's rule
+//! Jacobian J = [∂E/∂t, ∂E/∂z, −n] (see [`super::EdgeState`]); the 3×3 step is solved by Cramer's rule
 //! (no allocation). Start: the previous effective edge aligned with the ray,
 //! τ₀ = −gap/ω + (δ_i − δ_{i−m})/ω (methods.md eq. 0.2), corrected by the second-order crossing
 //! angle of eq. (2.7); z′ = z. Converged when the step is below
