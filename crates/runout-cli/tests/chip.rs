@@ -243,3 +243,25 @@ fn simulate_with_every_chip_model() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("chip_model") && err.contains("exact"), "{err}");
 }
+
+#[test]
+fn compare_machine_without_rtcp() {
+    let out = runout()
+        .args(["chip", "compare"])
+        .arg(example("joints_no_rtcp.toml"))
+        .args(["--json", "-"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v = json_of(&out.stdout);
+    let e = |m: &str| v["pooled"][m]["normalised_mae_percent"].as_f64().unwrap();
+    // fast head rotations (C 90° over 10 mm): still a second-order model, far better than arc
+    assert!(
+        e("equivalent") < 0.5 && e("equivalent") < 0.5 * e("arc"),
+        "{v}"
+    );
+}

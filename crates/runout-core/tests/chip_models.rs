@@ -495,3 +495,88 @@ fn compensation_fit_round_trip_recovers_known_k() {
     // wrong number of targets is a parameter error, not a panic
     assert!(fit_compensation_to(&kin, &calib, &targets[1..], true).is_err());
 }
+
+#[test]
+fn joint_path_velocities_match_finite_differences() {
+    // analytic Ṗ and Ω (used by the Newton Jacobian) vs central differences of P and u, e₁
+    let blocks = [
+        JointPoint {
+            xyz: Vec3::new(0.0, 0.0, 200.0),
+            a: deg(0.0),
+            c: deg(0.0),
+            feed: 30.0,
+        },
+        JointPoint {
+            xyz: Vec3::new(20.0, 5.0, 198.0),
+            a: deg(12.0),
+            c: deg(30.0),
+            feed: 30.0,
+        },
+        JointPoint {
+            xyz: Vec3::new(40.0, 8.0, 195.0),
+            a: deg(20.0),
+            c: deg(45.0),
+            feed: 30.0,
+        },
+    ];
+    let path = JointPath::new(&blocks, 150.0).unwrap();
+    let h = 1e-6;
+    for q in 1..20 {
+        let t = path.duration() * q as f64 / 20.0 + 1e-4;
+        let (a, b, c) = (path.pose(t - h), path.pose(t), path.pose(t + h));
+        let v_fd = (c.p - a.p) / (2.0 * h);
+        let u_fd = (c.u - a.u) / (2.0 * h);
+        let e_fd = (c.e1 - a.e1) / (2.0 * h);
+        // central differences: O(h²·|third derivative|) ≈ 1e-9 relative; rounding 1e-16/h ≈ 1e-10
+        assert!(
+            (v_fd - b.v).norm() < 1e-6 * b.v.norm().max(1.0),
+            "{v_fd} {}",
+            b.v
+        );
+        assert!((u_fd - b.w.cross(&b.u)).norm() < 1e-7);
+        assert!((e_fd - b.w.cross(&b.e1)).norm() < 1e-7);
+        assert!((b.u.norm() - 1.0).abs() < 1e-14 && b.u.dot(&b.e1).abs() < 1e-14);
+    }
+}
+
+#[test]
+fn joint_path_without_rotation_is_straight_feed() {
+    let cutter = Cutter::flat(8.0, 3, 30.0).unwrap();
+    let runout = Runout::new(0.01, deg(15.0)).unwrap();
+    let flat = straight_kin(&cutter, &runout, 0.1);
+    let v = flat.motion().v.x;
+    let blocks = [
+        JointPoint {
+            xyz: Vec3::new(-5.0, 0.0, 100.0),
+            a: 0.0,
+            c: 0.0,
+            feed: v,
+        },
+        JointPoint {
+            xyz: Vec3::new(5.0, 0.0, 100.0),
+            a: 0.0,
+            c: 0.0,
+            feed: v,
+        },
+    ];
+    let path = JointPath::new(&blocks, 100.0).unwrap(); // tip at z = 0
+    let shift = 5.0 / v;
+    let joints = ToolKinematics::new(
+        &cutter,
+        &runout,
+        60.0,
+        -TAU * shift,
+        SpindleSense::Clockwise,
+        path,
+    )
+    .unwrap();
+    let opts = NewtonOptions::default();
+    for tooth in 0..3 {
+        for q in 0..10 {
+            let t = 1.0 + 0.1 * q as f64;
+            let a = exact_iuct(&flat, tooth, 2.0, t, &opts).raw;
+            let b = exact_iuct(&joints, tooth, 2.0, t + shift, &opts);
+            assert!(b.converged && (a - b.raw).abs() < 1e-11, "{a} {}", b.raw);
+        }
+    }
+}

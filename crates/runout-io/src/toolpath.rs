@@ -457,3 +457,125 @@ impl Toolpath {
         Ok(out)
     }
 }
+
+/// One block of a joint-space program (machine without RTCP, head-head A/C kinematics).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointBlock {
+    /// Pivot position X, Y, Z (mm).
+    pub xyz: [f64; 3],
+    /// A axis (deg, about x).
+    pub a_deg: f64,
+    /// C axis (deg, about z).
+    pub c_deg: f64,
+    /// Feed (mm/min) of the move that reaches this block, if given (modal).
+    pub feed_mm_min: Option<f64>,
+    /// 1-based line.
+    pub line: usize,
+}
+
+/// Parse CSV `x_mm,y_mm,z_mm,a_deg,c_deg[,feed_mm_min]` (optional header, `#` comments):
+/// machine joints for [`runout_core::chip::JointPath`].
+///
+/// ```
+/// let j = runout_io::toolpath::parse_joint_csv("j.csv", "x_mm,y_mm,z_mm,a_deg,c_deg,feed_mm_min\n0,0,150,0,0,600\n10,0,150,5,0\n").unwrap();
+/// assert_eq!(j.len(), 2);
+/// assert_eq!(j[1].feed_mm_min, Some(600.0));
+/// ```
+pub fn parse_joint_csv(file: &str, text: &str) -> Result<Vec<JointBlock>, ToolpathError> {
+    const HEADER: [&str; 6] = ["x_mm", "y_mm", "z_mm", "a_deg", "c_deg", "feed_mm_min"];
+    let err = |line: usize, message: String| ToolpathError::Parse {
+        file: file.into(),
+        line,
+        message,
+    };
+    let mut out: Vec<JointBlock> = Vec::new();
+    for (idx, raw) in text.lines().enumerate() {
+        let line = idx + 1;
+        let body = raw.split('#').next().unwrap_or("").trim();
+        if body.is_empty() {
+            continue;
+        }
+        let fields: Vec<&str> = body.split(',').map(str::trim).collect();
+        if out.is_empty() && fields[0].parse::<f64>().is_err() {
+            let ok = (5..=6).contains(&fields.len())
+                && fields
+                    .iter()
+                    .zip(HEADER)
+                    .all(|(f, h)| f.eq_ignore_ascii_case(h));
+            if !ok {
+                return Err(err(
+                    line,
+                    format!("header `{body}`: expected {}", HEADER.join(",")),
+                ));
+            }
+            continue;
+        }
+        if !(5..=6).contains(&fields.len()) {
+            return Err(err(
+                line,
+                format!(
+                    "expected 5 or 6 fields (x_mm,y_mm,z_mm,a_deg,c_deg[,feed_mm_min]), got {}",
+                    fields.len()
+                ),
+            ));
+        }
+        let mut v = [0.0; 6];
+        for (q, f) in fields.iter().enumerate() {
+            v[q] = f
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| err(line, format!("field {} (`{f}`) is not a number", q + 1)))?;
+        }
+        let feed = if fields.len() == 6 {
+            if v[5] <= 0.0 {
+                return Err(err(line, format!("feed_mm_min must be > 0, got {}", v[5])));
+            }
+            Some(v[5])
+        } else {
+            out.last().and_then(|b| b.feed_mm_min)
+        };
+        out.push(JointBlock {
+            xyz: [v[0], v[1], v[2]],
+            a_deg: v[3],
+            c_deg: v[4],
+            feed_mm_min: feed,
+            line,
+        });
+    }
+    if out.len() < 2 {
+        return Err(ToolpathError::Path {
+            file: file.into(),
+            message: "fewer than 2 joint blocks".into(),
+        });
+    }
+    Ok(out)
+}
+
+/// Joint blocks → [`runout_core::chip::JointPoint`] (rad, feed mm/s of the move to the next
+/// block = the feed read with that next block; `default_feed_mm_min` fills a missing one).
+pub fn joint_points(
+    file: &str,
+    blocks: &[JointBlock],
+    default_feed_mm_min: Option<f64>,
+) -> Result<Vec<runout_core::chip::JointPoint>, ToolpathError> {
+    let mut out = Vec::with_capacity(blocks.len());
+    for (n, b) in blocks.iter().enumerate() {
+        let next = blocks.get(n + 1).or(blocks.get(n.saturating_sub(1)));
+        let feed = next
+            .and_then(|q| q.feed_mm_min)
+            .or(default_feed_mm_min)
+            .ok_or_else(|| ToolpathError::Parse {
+                file: file.into(),
+                line: b.line,
+                message: "no feed for the move from this block: give feed_mm_min".into(),
+            })?;
+        out.push(runout_core::chip::JointPoint {
+            xyz: Vec3::new(b.xyz[0], b.xyz[1], b.xyz[2]),
+            a: b.a_deg.to_radians(),
+            c: b.c_deg.to_radians(),
+            feed: feed / 60.0,
+        });
+    }
+    Ok(out)
+}

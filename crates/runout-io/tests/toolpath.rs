@@ -146,3 +146,29 @@ fn read_toolpath_by_extension() {
     let e = read_toolpath(&dir.path().join("missing.apt")).unwrap_err();
     assert!(e.to_string().contains("missing.apt"));
 }
+
+#[test]
+fn joint_csv_for_machines_without_rtcp() {
+    use runout_io::toolpath::{joint_points, parse_joint_csv};
+    let text =
+        "# head-head\nx_mm,y_mm,z_mm,a_deg,c_deg,feed_mm_min\n0,0,150,0,0,600\n10,0,150,5,90\n";
+    let blocks = parse_joint_csv("j.csv", text).unwrap();
+    assert_eq!(blocks.len(), 2);
+    assert_eq!(blocks[1].line, 4);
+    let pts = joint_points("j.csv", &blocks, None).unwrap();
+    assert!((pts[1].c - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    assert!((pts[0].feed - 10.0).abs() < 1e-12); // 600 mm/min
+    let path = runout_core::chip::JointPath::new(&pts, 150.0).unwrap();
+    assert!(path.duration() > 0.0);
+    let (line, msg) =
+        parse_err(parse_joint_csv("j.csv", "0,0,150,0,0,600\n1,0,150,x,0\n").unwrap_err());
+    assert_eq!(line, 2);
+    assert!(msg.contains("`x`"), "{msg}");
+    let (line, _) = parse_err(parse_joint_csv("j.csv", "0,0,150,0\n").unwrap_err());
+    assert_eq!(line, 1);
+    let blocks = parse_joint_csv("j.csv", "0,0,150,0,0\n1,0,150,0,0\n").unwrap();
+    assert!(joint_points("j.csv", &blocks, None)
+        .unwrap_err()
+        .to_string()
+        .contains("no feed"));
+}

@@ -7,8 +7,8 @@
 use super::closed_form::{arc_at, closed_forms_at, equivalent_at, EquivalentParams};
 use super::exact::{exact_at, NewtonOptions};
 use super::kinematics::{
-    CircularFeed, ClPath, ConstantSwing, HeightGeometry, Pose, StraightFeed, ToolKinematics,
-    ToolMotion,
+    CircularFeed, ClPath, ConstantSwing, HeightGeometry, JointPath, Pose, StraightFeed,
+    ToolKinematics, ToolMotion,
 };
 
 /// Any of the supported tool motions (one type, so a case set can mix them).
@@ -22,6 +22,8 @@ pub enum Motion {
     Swing(ConstantSwing),
     /// CL-path-driven 5-axis motion.
     Path(ClPath),
+    /// Joint-space interpolation without RTCP.
+    Joints(JointPath),
 }
 
 impl ToolMotion for Motion {
@@ -32,6 +34,7 @@ impl ToolMotion for Motion {
             Motion::Circular(m) => m.pose(t),
             Motion::Swing(m) => m.pose(t),
             Motion::Path(m) => m.pose(t),
+            Motion::Joints(m) => m.pose(t),
         }
     }
 }

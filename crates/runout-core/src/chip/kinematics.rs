@@ -379,6 +379,111 @@ impl ToolMotion for ClPath {
     }
 }
 
+/// Machine joints of a head-head 5-axis machine at one CL block: pivot position (X, Y, Z),
+/// head rotations A (about x) and C (about z), feed to the next block.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointPoint {
+    /// Pivot point position (mm), workpiece frame.
+    pub xyz: Vec3,
+    /// A axis (rad), rotation about x.
+    pub a: f64,
+    /// C axis (rad), rotation about z.
+    pub c: f64,
+    /// Tip feed (mm/s) of the move to the next block.
+    pub feed: f64,
+}
+
+/// Motion of a machine **without RTCP** (methods.md §2.1): the joints (X, Y, Z, A, C) are
+/// interpolated linearly between blocks and the tool pose follows from the forward kinematics of a
+/// head-head machine with pivot length L (pivot → tool tip):
+///
+/// R = Rz(C)·Rx(A), u = R ẑ, e₁ = R ŷ, P = X − L·u,
+/// Ω = Ċ ẑ + Ȧ Rz(C) x̂, Ṗ = Ẋ − L·Ω × u.
+///
+/// Segment durations: tip chord |P_{n+1} − P_n| / F_n. Extrapolated outside the blocks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointPath {
+    points: Vec<JointPoint>,
+    times: Vec<f64>,
+    pivot: f64,
+}
+
+impl JointPath {
+    /// Joint path with pivot length `pivot_mm` (≥ 0).
+    pub fn new(points: &[JointPoint], pivot_mm: f64) -> Result<Self, ParamError> {
+        if points.len() < 2 {
+            return Err(ParamError::new(
+                "joint_path",
+                "at least 2 blocks",
+                points.len(),
+            ));
+        }
+        finite("pivot_mm", pivot_mm)?;
+        let mut times = vec![0.0];
+        for (n, w) in points.windows(2).enumerate() {
+            let chord = (Self::tip(&w[1], pivot_mm) - Self::tip(&w[0], pivot_mm)).norm();
+            if !(w[0].feed.is_finite() && w[0].feed > 0.0) || chord <= 1e-12 {
+                return Err(ParamError::new(
+                    format!("joint_path block {n}"),
+                    "a feed > 0 and a tip move of non-zero length",
+                    format!("feed {} mm/s, chord {chord} mm", w[0].feed),
+                ));
+            }
+            times.push(times[n] + chord / w[0].feed);
+        }
+        Ok(JointPath {
+            points: points.to_vec(),
+            times,
+            pivot: pivot_mm,
+        })
+    }
+
+    fn rotation(a: f64, c: f64) -> (Vec3, Vec3, Vec3) {
+        let (sa, ca) = a.sin_cos();
+        let (sc, cc) = c.sin_cos();
+        // columns of Rz(C)·Rx(A): images of x̂, ŷ, ẑ
+        let x = Vec3::new(cc, sc, 0.0);
+        let y = Vec3::new(-sc * ca, cc * ca, sa);
+        let z = Vec3::new(sc * sa, -cc * sa, ca);
+        (x, y, z)
+    }
+
+    /// Tool tip of a block (forward kinematics).
+    pub fn tip(q: &JointPoint, pivot: f64) -> Vec3 {
+        q.xyz - Self::rotation(q.a, q.c).2 * pivot
+    }
+
+    /// Total duration (s).
+    pub fn duration(&self) -> f64 {
+        *self.times.last().expect("≥ 2 blocks")
+    }
+}
+
+impl ToolMotion for JointPath {
+    fn pose(&self, t: f64) -> Pose {
+        let n = self
+            .times
+            .partition_point(|&s| s <= t)
+            .clamp(1, self.points.len() - 1)
+            - 1;
+        let (p0, p1) = (&self.points[n], &self.points[n + 1]);
+        let dt = self.times[n + 1] - self.times[n];
+        let s = (t - self.times[n]) / dt;
+        let (a, c) = (p0.a + s * (p1.a - p0.a), p0.c + s * (p1.c - p0.c));
+        let (a_dot, c_dot) = ((p1.a - p0.a) / dt, (p1.c - p0.c) / dt);
+        let (x_rot, e1, u) = Self::rotation(a, c);
+        let w = Vec3::z() * c_dot + Vec3::new(x_rot.x, x_rot.y, 0.0) * a_dot;
+        let xyz = p0.xyz + (p1.xyz - p0.xyz) * s;
+        Pose {
+            p: xyz - u * self.pivot,
+            u,
+            e1,
+            v: (p1.xyz - p0.xyz) / dt - w.cross(&u) * self.pivot,
+            w,
+        }
+    }
+}
+
 /// Direction of spindle rotation seen from above the tool (looking down −u).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SpindleSense {

@@ -25,8 +25,8 @@ pub use exact::{
     crossing_at, exact_at, exact_iuct, ray_crossing, ExactIuct, NewtonOptions, Ray, RayCrossing,
 };
 pub use kinematics::{
-    CircularFeed, ClPath, ClPoint, ConstantSwing, EdgeState, HeightGeometry, Pose, SpindlePoint,
-    SpindleSense, StraightFeed, ToolKinematics, ToolMotion, Vec3,
+    CircularFeed, ClPath, ClPoint, ConstantSwing, EdgeState, HeightGeometry, JointPath, JointPoint,
+    Pose, SpindlePoint, SpindleSense, StraightFeed, ToolKinematics, ToolMotion, Vec3,
 };
 pub use straight::{
     straight_feed_kinematics, EquivalentAtHeight, EquivalentChip, ExactAtHeight, ExactChip,

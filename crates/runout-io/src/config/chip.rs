@@ -16,12 +16,14 @@
 //!
 //! Motions (methods.md §2.1): `straight` (feed +x, axis +z), `circular` (`path_radius_mm`,
 //! `path_ccw`), `swing` (`swing_axis`, `swing_deg_s`, `pivot_mm`), `path` (`toolpath` = APT/CSV
-//! file relative to the config, `feed_mm_min` fills a missing feed).
+//! file relative to the config, `feed_mm_min` fills a missing feed), `joints` (`joints` = joint CSV
+//! of a machine without RTCP, `pivot_mm` = head pivot length).
 
-use crate::toolpath::read_toolpath;
+use crate::toolpath::{joint_points, parse_joint_csv, read_toolpath};
 use runout_core::chip::compare::{sample_grid, Motion, SamplePoint};
 use runout_core::chip::{
-    CircularFeed, ClPath, ConstantSwing, SpindleSense, StraightFeed, ToolKinematics, Vec3,
+    CircularFeed, ClPath, ConstantSwing, JointPath, SpindleSense, StraightFeed, ToolKinematics,
+    Vec3,
 };
 use runout_core::{Cutter, RadiusProfile, Runout};
 use serde::Deserialize;
@@ -79,7 +81,7 @@ pub struct ChipCaseSpec {
     /// Swing rate (deg/s), for `swing`.
     #[serde(default)]
     pub swing_deg_s: f64,
-    /// Pivot height above the tip (mm), for `swing`.
+    /// Pivot height above the tip (mm), for `swing`; pivot length of the head, for `joints`.
     #[serde(default)]
     pub pivot_mm: f64,
     /// Path radius (mm), for `circular`.
@@ -91,6 +93,10 @@ pub struct ChipCaseSpec {
     /// CL file (APT or CSV), for `path`; relative to the config file.
     #[serde(default)]
     pub toolpath: Option<String>,
+    /// Joint CSV (`x_mm,y_mm,z_mm,a_deg,c_deg[,feed_mm_min]`), for `joints` (machine without
+    /// RTCP, head-head A/C kinematics with pivot length `pivot_mm`); relative to the config file.
+    #[serde(default)]
+    pub joints: Option<String>,
     /// Feed (mm/min) for CL points without one.
     #[serde(default)]
     pub feed_mm_min: Option<f64>,
@@ -305,9 +311,22 @@ fn motion_of(s: &ChipCaseSpec, base: &Path) -> Result<(Motion, Vec<String>), Str
             let path = ClPath::new(&cl).map_err(|e| format!("{name}: {e}"))?;
             (Motion::Path(path), tp.warnings)
         }
+        "joints" => {
+            let file = s
+                .joints
+                .as_ref()
+                .ok_or("joints: required for motion joints")?;
+            let full = base.join(file);
+            let name = full.display().to_string();
+            let text = std::fs::read_to_string(&full).map_err(|e| format!("{name}: {e}"))?;
+            let blocks = parse_joint_csv(&name, &text).map_err(|e| e.to_string())?;
+            let pts = joint_points(&name, &blocks, s.feed_mm_min).map_err(|e| e.to_string())?;
+            let path = JointPath::new(&pts, s.pivot_mm).map_err(|e| format!("{name}: {e}"))?;
+            (Motion::Joints(path), vec![])
+        }
         o => {
             return Err(format!(
-                "motion: expected straight, circular, swing or path, got `{o}`"
+                "motion: expected straight, circular, swing, path or joints, got `{o}`"
             ))
         }
     })
@@ -334,6 +353,7 @@ pub fn resolve_case(
     let (motion, warnings) = motion_of(&spec, base).map_err(err)?;
     let duration = match &motion {
         Motion::Path(p) => Some(p.duration()),
+        Motion::Joints(p) => Some(p.duration()),
         _ => None,
     };
     let kin = ToolKinematics::new(&cutter, &runout, spec.rpm, 0.0, sense, motion)
