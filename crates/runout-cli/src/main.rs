@@ -27,6 +27,8 @@ enum Command {
     /// Runout identified in position from displacement readings: per-tooth readings, runout at
     /// several heights, or a raw signal (methods.md §1).
     Displacement(cmd::displacement::Args),
+    /// Chip thickness with runout (exact, arc, equivalent models; 3-axis and 5-axis toolpaths).
+    Chip(cmd::chip::Args),
     /// Tool grinding: compensate the bar clamping error (probe grid → wheel path / NC program).
     Grind(cmd::grind::Args),
     /// Cutting force and runout from two-point shank deflection (capacitive sensors).
@@ -38,6 +40,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Displacement(a) => cmd::displacement::run(a),
+        Command::Chip(a) => cmd::chip::run(a),
         Command::Grind(a) => cmd::grind::run(a),
         Command::Shank(a) => cmd::shank::run(a),
     };

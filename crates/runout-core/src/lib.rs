@@ -30,7 +30,7 @@ pub mod grind;
 pub mod runout;
 pub mod shank;
 
-pub use chip::{ArcChip, ChipAtHeight, ChipThickness};
+pub use chip::{ArcChip, ChipAtHeight, ChipThickness, EquivalentChip, ExactChip};
 pub use coefficients::CuttingCoefficients;
 pub use cut::{Cut, Engagement, MillingMode};
 pub use cutter::{Cutter, RadiusProfile};

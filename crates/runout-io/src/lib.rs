@@ -14,4 +14,5 @@ pub mod grind;
 pub mod lineplot;
 pub mod plot;
 pub mod recording;
+pub mod toolpath;
 pub mod units;

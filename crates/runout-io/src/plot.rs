@@ -1,6 +1,7 @@
 //! Plots (SVG and PNG by file extension) with plotters. PNG text is rasterised from an embedded
 //! DejaVu Sans font (Bitstream Vera licence), so no system fonts are needed.
 
+pub mod chip;
 pub mod identify;
 
 use plotters::coord::Shift;

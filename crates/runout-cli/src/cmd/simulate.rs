@@ -2,7 +2,10 @@
 
 use crate::output;
 use anyhow::{Context, Result};
-use runout_core::{tooth_peaks, ArcChip, ForceModel, ForceSeries, ToothPeak};
+use runout_core::chip::EquivalentParams;
+use runout_core::{
+    tooth_peaks, ArcChip, EquivalentChip, ExactChip, ForceModel, ForceSeries, ToothPeak,
+};
 use runout_io::config::simulate::{resolve_simulate, simulate_key_names, SimulateCase};
 use runout_io::config::{layer_from_toml, Layer, Settings, Value};
 use runout_io::units::{parse_quantity, Quantity};
@@ -99,7 +102,7 @@ pub struct Args {
     /// Number of axial disks (count).
     #[arg(long, allow_hyphen_values = true)]
     pub disks: Option<String>,
-    /// Chip-thickness model: arc.
+    /// Chip-thickness model: arc | exact | equivalent (methods.md eq. 0.4, 2.2–2.3, 2.8).
     #[arg(long, allow_hyphen_values = true)]
     pub chip_model: Option<String>,
     /// Write the force time series as CSV (time_s, angle_deg, fx_N, fy_N, fz_N, torque_Nm, h<i>_mm); `-` for stdout.
@@ -235,8 +238,7 @@ pub fn run(a: Args) -> Result<()> {
         cut: case.cut,
         coefficients: case.coefficients,
     };
-    let chip = ArcChip::new(&case.cutter, &case.runout, case.cut.fz())?;
-    let series = model.simulate(&chip, &case.sampling);
+    let series = simulate_with(&model, &case)?;
     let peaks = tooth_peaks(&series, &case.cutter, &case.cut);
 
     if let Some(out) = &a.out {
@@ -263,6 +265,19 @@ pub fn run(a: Args) -> Result<()> {
         print_text(&case, &series, &peaks);
     }
     Ok(())
+}
+
+/// Run the simulation with the configured chip-thickness model.
+fn simulate_with(model: &ForceModel, case: &SimulateCase) -> Result<ForceSeries> {
+    let (c, r, fz) = (&case.cutter, &case.runout, case.cut.fz());
+    Ok(match case.chip_model.as_str() {
+        "exact" => model.simulate(&ExactChip::new(c, r, fz)?, &case.sampling),
+        "equivalent" => model.simulate(
+            &EquivalentChip::new(c, r, fz, EquivalentParams::default())?,
+            &case.sampling,
+        ),
+        _ => model.simulate(&ArcChip::new(c, r, fz)?, &case.sampling),
+    })
 }
 
 fn parse_flag(flag: &str, text: &str, q: Quantity) -> Result<f64> {

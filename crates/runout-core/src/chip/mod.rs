@@ -6,8 +6,31 @@
 //! this interface, so every model can drive it.
 
 mod arc;
+pub mod closed_form;
+pub mod compare;
+pub mod compensation;
+pub mod exact;
+pub mod kinematics;
+mod straight;
 
 pub use arc::{ArcAtHeight, ArcChip};
+pub use closed_form::{
+    arc_at, arc_iuct, closed_forms, closed_forms_at, equivalent_at, equivalent_iuct, pass_terms,
+    ClosedForms, EquivalentParams, PassTerms,
+};
+pub use compensation::{
+    calibration_grid, fit_compensation, fit_compensation_to, CalibrationPoint, CompensationFit,
+};
+pub use exact::{
+    crossing_at, exact_at, exact_iuct, ray_crossing, ExactIuct, NewtonOptions, Ray, RayCrossing,
+};
+pub use kinematics::{
+    CircularFeed, ClPath, ClPoint, ConstantSwing, EdgeState, HeightGeometry, JointPath, JointPoint,
+    Pose, SpindlePoint, SpindleSense, StraightFeed, ToolKinematics, ToolMotion, Vec3,
+};
+pub use straight::{
+    straight_feed_kinematics, EquivalentAtHeight, EquivalentChip, ExactAtHeight, ExactChip,
+};
 
 /// A chip-thickness model for steady 3-axis straight feed.
 ///

@@ -3,6 +3,7 @@
 //! command-line flag; flags override the file.
 
 pub mod shank;
+pub mod chip;
 pub mod simulate;
 
 use crate::units::{parse_quantity, Quantity};

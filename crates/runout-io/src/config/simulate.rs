@@ -113,9 +113,12 @@ pub const SIMULATE_KEYS: &[(&str, Quantity, &str)] = &[
     (
         "chip_model",
         Quantity::Dimensionless,
-        "chip-thickness model: arc [default arc]",
+        "chip-thickness model: arc | exact | equivalent (methods.md §2) [default arc]",
     ),
 ];
+
+/// Accepted values of `chip_model`: arc (eq. 0.4), exact (eq. 2.2–2.3), equivalent (eq. 2.8).
+pub const CHIP_MODELS: &[&str] = &["arc", "exact", "equivalent"];
 
 /// Names of all keys.
 pub fn simulate_key_names() -> Vec<&'static str> {
@@ -268,11 +271,14 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
         .unwrap_or(if helix == 0.0 { 1 } else { 50 });
     let sampling = Sampling::new(revolutions, step, disks).map_err(|e| key_err(s, e))?;
     let chip_model = s.text("chip_model")?.unwrap_or_else(|| "arc".into());
-    if chip_model != "arc" {
+    if !CHIP_MODELS.contains(&chip_model.as_str()) {
         return Err(ConfigError::Key {
             source_name: s.origin("chip_model").unwrap_or("config").into(),
             key: "chip_model".into(),
-            message: format!("expected one of: arc; got `{chip_model}`"),
+            message: format!(
+                "expected one of: {}; got `{chip_model}`",
+                CHIP_MODELS.join(", ")
+            ),
         });
     }
     Ok(SimulateCase {

@@ -1,0 +1,215 @@
+//! Model comparison on a case (methods.md §2.5): exact vs arc, circle-intersection and
+//! equivalent IUCT on a grid of (tooth, height, time), with the two error metrics of §2.5:
+//!
+//! * mean relative error: mean |Δh|/h_exact over points with h_exact > 5 % of max h_exact;
+//! * normalised MAE: Σ|Δh| / Σ h_exact over all points.
+
+use super::closed_form::{arc_at, closed_forms_at, equivalent_at, EquivalentParams};
+use super::exact::{exact_at, NewtonOptions};
+use super::kinematics::{
+    CircularFeed, ClPath, ConstantSwing, HeightGeometry, JointPath, Pose, StraightFeed,
+    ToolKinematics, ToolMotion,
+};
+
+/// Any of the supported tool motions (one type, so a case set can mix them).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Motion {
+    /// 3-axis straight feed.
+    Straight(StraightFeed),
+    /// 3-axis circular feed.
+    Circular(CircularFeed),
+    /// Feed with a constant-rate axis swing.
+    Swing(ConstantSwing),
+    /// CL-path-driven 5-axis motion.
+    Path(ClPath),
+    /// Joint-space interpolation without RTCP.
+    Joints(JointPath),
+}
+
+impl ToolMotion for Motion {
+    #[inline]
+    fn pose(&self, t: f64) -> Pose {
+        match self {
+            Motion::Straight(m) => m.pose(t),
+            Motion::Circular(m) => m.pose(t),
+            Motion::Swing(m) => m.pose(t),
+            Motion::Path(m) => m.pose(t),
+            Motion::Joints(m) => m.pose(t),
+        }
+    }
+}
+
+/// One evaluation point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SamplePoint {
+    /// Tooth.
+    pub tooth: usize,
+    /// Height z (mm).
+    pub z: f64,
+    /// Time t (s).
+    pub t: f64,
+}
+
+/// The grid: every tooth at every height at `samples` times evenly spread over
+/// [t0, t0 + span).
+pub fn sample_grid(
+    teeth: usize,
+    heights: &[f64],
+    t0: f64,
+    span: f64,
+    samples: usize,
+) -> Vec<SamplePoint> {
+    let mut out = Vec::with_capacity(teeth * heights.len() * samples);
+    for j in 0..samples {
+        let t = t0 + span * j as f64 / samples as f64;
+        for &z in heights {
+            for tooth in 0..teeth {
+                out.push(SamplePoint { tooth, z, t });
+            }
+        }
+    }
+    out
+}
+
+/// h (mm, ≥ 0) of every model at every point.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ModelValues {
+    /// Exact, eq. (2.2)–(2.3).
+    pub exact: Vec<f64>,
+    /// Linear arc, eq. (2.5).
+    pub arc: Vec<f64>,
+    /// Circle intersection, eq. (2.6).
+    pub circle: Vec<f64>,
+    /// Equivalent, eq. (2.8).
+    pub equivalent: Vec<f64>,
+    /// Points where the exact Newton solve missed its tolerance (should be 0).
+    pub unconverged: usize,
+}
+
+/// Height geometries of the distinct heights of `points` (looked up by exact equality).
+struct Heights(Vec<HeightGeometry>);
+
+impl Heights {
+    fn new<M: ToolMotion>(kin: &ToolKinematics<M>, points: &[SamplePoint]) -> Self {
+        let mut v: Vec<HeightGeometry> = Vec::new();
+        for q in points {
+            if !v.iter().any(|g| g.z == q.z) {
+                v.push(kin.at_height(q.z));
+            }
+        }
+        Heights(v)
+    }
+    fn get(&self, z: f64) -> &HeightGeometry {
+        self.0.iter().find(|g| g.z == z).expect("prepared")
+    }
+}
+
+/// Evaluate all models at `points`.
+pub fn evaluate_models<M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    points: &[SamplePoint],
+    params: &EquivalentParams,
+) -> ModelValues {
+    let opts = NewtonOptions::default();
+    let heights = Heights::new(kin, points);
+    let mut v = ModelValues::default();
+    for q in points {
+        let geo = heights.get(q.z);
+        let e = exact_at(kin, geo, q.tooth, q.t, &opts);
+        v.unconverged += usize::from(!e.converged);
+        v.exact.push(e.h());
+        let c = closed_forms_at(kin, geo, q.tooth, q.t, params);
+        v.arc.push(c.arc.max(0.0));
+        v.circle.push(c.circle.max(0.0));
+        v.equivalent.push(c.equivalent.max(0.0));
+    }
+    v
+}
+
+/// Exact h only (for throughput measurement).
+pub fn exact_values<M: ToolMotion>(kin: &ToolKinematics<M>, points: &[SamplePoint]) -> Vec<f64> {
+    let opts = NewtonOptions::default();
+    let heights = Heights::new(kin, points);
+    points
+        .iter()
+        .map(|q| exact_at(kin, heights.get(q.z), q.tooth, q.t, &opts).h())
+        .collect()
+}
+
+/// Equivalent h only (for throughput measurement).
+pub fn equivalent_values<M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    points: &[SamplePoint],
+    params: &EquivalentParams,
+) -> Vec<f64> {
+    let heights = Heights::new(kin, points);
+    points
+        .iter()
+        .map(|q| equivalent_at(kin, heights.get(q.z), q.tooth, q.t, params).max(0.0))
+        .collect()
+}
+
+/// Linear-arc h only (for throughput measurement).
+pub fn arc_values<M: ToolMotion>(kin: &ToolKinematics<M>, points: &[SamplePoint]) -> Vec<f64> {
+    let heights = Heights::new(kin, points);
+    points
+        .iter()
+        .map(|q| arc_at(kin, heights.get(q.z), q.tooth, q.t).max(0.0))
+        .collect()
+}
+
+/// Error of a model against the exact values (methods.md §2.5 metrics).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ErrorMetrics {
+    /// Mean |Δh|/h over points with h_exact > 5 % of max h_exact (fraction, not %).
+    pub mean_relative: f64,
+    /// Σ|Δh| / Σ h_exact over all points (fraction).
+    pub normalised_mae: f64,
+    /// Largest |Δh| (mm).
+    pub max_abs_mm: f64,
+    /// Points entering the relative metric.
+    pub points_relative: usize,
+}
+
+/// Accumulators so that several cases can be pooled.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ErrorAccumulator {
+    rel_sum: f64,
+    rel_n: usize,
+    abs_sum: f64,
+    h_sum: f64,
+    max_abs: f64,
+}
+
+impl ErrorAccumulator {
+    /// Add one case: `model` vs `exact` values (same order).
+    pub fn add(&mut self, model: &[f64], exact: &[f64]) {
+        let hmax = exact.iter().copied().fold(0.0, f64::max);
+        for (m, e) in model.iter().zip(exact) {
+            let d = (m - e).abs();
+            self.abs_sum += d;
+            self.h_sum += e;
+            self.max_abs = self.max_abs.max(d);
+            if *e > 0.05 * hmax {
+                self.rel_sum += d / e;
+                self.rel_n += 1;
+            }
+        }
+    }
+    /// The metrics so far.
+    pub fn metrics(&self) -> ErrorMetrics {
+        ErrorMetrics {
+            mean_relative: self.rel_sum / self.rel_n.max(1) as f64,
+            normalised_mae: self.abs_sum / self.h_sum.max(f64::MIN_POSITIVE),
+            max_abs_mm: self.max_abs,
+            points_relative: self.rel_n,
+        }
+    }
+}
+
+/// Metrics of one model against exact.
+pub fn error_metrics(model: &[f64], exact: &[f64]) -> ErrorMetrics {
+    let mut acc = ErrorAccumulator::default();
+    acc.add(model, exact);
+    acc.metrics()
+}
