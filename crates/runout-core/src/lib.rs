@@ -26,6 +26,7 @@ pub mod cutter;
 pub mod error;
 pub mod force;
 pub mod runout;
+pub mod signal;
 
 pub use chip::{ArcChip, ChipAtHeight, ChipThickness};
 pub use coefficients::CuttingCoefficients;
