@@ -19,6 +19,8 @@
 //! its uncertainty is the revolution-to-revolution scatter: the per-revolution maxima in the
 //! same period give mean ± sd, and se = sd/√n.
 //!
+//! The air-cut offset found in pass 1 is subtracted first (`SignalConfig::subtract_air_offset`).
+//!
 //! Memory: one revolution of samples (3 channels) + 4·M running statistics + K per-tooth.
 
 use super::chunk::ChunkGuard;
@@ -112,6 +114,9 @@ pub struct SyncAverage {
     pub revolutions: usize,
     /// F_z was recorded (otherwise its average is 0).
     pub has_fz: bool,
+    /// Static offset (F_x, F_y, F_z) subtracted from every sample before averaging (N), if any.
+    #[serde(rename = "offset_subtracted_N")]
+    pub offset_subtracted: Option<[f64; 3]>,
     /// Averages of F_x, F_y, F_z, |F_xy| in [`Component::ALL`] order.
     pub components: Vec<ComponentAverage>,
     /// Component whose per-tooth peaks are given.
@@ -162,6 +167,7 @@ pub struct SyncAverager {
     teeth: Vec<RunningStats>,
     revs: usize,
     has_fz: bool,
+    offset: Option<[f64; 3]>,
 }
 
 impl SyncAverager {
@@ -222,6 +228,7 @@ impl SyncAverager {
             teeth: vec![RunningStats::default(); cfg.teeth],
             revs: 0,
             has_fz: scan.has_fz,
+            offset: if cfg.subtract_air_offset { scan.section.air_offset } else { None },
         })
     }
 
@@ -242,7 +249,11 @@ impl SyncAverager {
             if self.buf.is_empty() {
                 self.buf_start = n;
             }
-            self.buf.push(c.force(i));
+            let mut f = c.force(i);
+            if let Some(o) = self.offset {
+                f = [f[0] - o[0], f[1] - o[1], f[2] - o[2]];
+            }
+            self.buf.push(f);
             if self.buf.len() > self.max_buf {
                 return Err(SignalError::Pulse {
                     reason: format!(
@@ -375,6 +386,7 @@ impl SyncAverager {
             angle_reference: self.angle_reference,
             revolutions: self.revs,
             has_fz: self.has_fz,
+            offset_subtracted: self.offset,
             components,
             peak_component: self.component,
             tooth_reference: if self.absolute_start.is_some() {

@@ -112,6 +112,9 @@ pub struct SignalConfig {
     /// `tooth0_angle_rad` it makes tooth periods absolute: tooth i owns θ ∈ [φ_st + 2πi/K,
     /// φ_st + 2π(i+1)/K) as in `force::tooth_peaks`.
     pub entry_angle_rad: Option<f64>,
+    /// Subtract the air-cut mean force (the instrument's static offset, found by the steady-cut
+    /// detector) before averaging (default true; nothing is subtracted when there is no air cut).
+    pub subtract_air_offset: bool,
 }
 
 impl SignalConfig {
@@ -127,6 +130,7 @@ impl SignalConfig {
             section_s: None,
             pulse: None,
             entry_angle_rad: None,
+            subtract_air_offset: true,
         };
         c.validate()?;
         Ok(c)

@@ -84,7 +84,11 @@ impl SpindleScan {
         let line = self.welch.tooth_passing(cfg.teeth, cfg.nominal_rpm, cfg.search_band)?;
         let coarse = line.hz / cfg.teeth as f64;
         let section = match cfg.section_s {
-            Some((a, b)) => override_section(a, b, duration_s, 60.0 / cfg.nominal_rpm)?,
+            Some((a, b)) => {
+                let mut s = override_section(a, b, duration_s, 60.0 / cfg.nominal_rpm)?;
+                s.air_offset = self.envelope.detect(fs, 60.0 / cfg.nominal_rpm).ok().and_then(|d| d.air_offset);
+                s
+            }
             None => self.envelope.detect(fs, 60.0 / cfg.nominal_rpm)?,
         };
         let pulse_thresholds = match cfg.pulse {
@@ -135,5 +139,6 @@ fn override_section(a: f64, b: f64, duration: f64, rev_s: f64) -> Result<SteadyS
         threshold: f64::NAN,
         trim_tolerance: 0.0,
         trimmed_blocks: 0,
+        air_offset: None,
     })
 }

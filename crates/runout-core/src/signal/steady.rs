@@ -14,6 +14,9 @@
 //! 2. Entry/exit trimming: blocks at either end of the run whose level differs from the run's
 //!    median by more than tol = max(5 %, 4·1.4826·MAD/median) are removed.
 //! 3. At least two revolutions must remain.
+//!
+//! The mean force over the air-cut blocks (level ≤ 2·ℓ_lo) is the instrument's static offset,
+//! reported and (by default) subtracted before averaging.
 
 use super::SignalError;
 use crate::signal::stats::{median, quantile};
@@ -82,6 +85,10 @@ pub struct SteadySection {
     pub trim_tolerance: f64,
     /// Blocks removed as entry/exit transients.
     pub trimmed_blocks: usize,
+    /// Mean force (F_x, F_y, F_z) over the air-cut blocks (level ≤ 2·ℓ_lo), N: the static
+    /// offset of the instrument; `None` when no air cut was distinguishable.
+    #[serde(rename = "air_offset_N")]
+    pub air_offset: Option<[f64; 3]>,
 }
 
 impl Envelope {
@@ -112,15 +119,23 @@ impl Envelope {
         }
     }
 
-    /// Levels ℓ_r of the complete blocks (N).
-    fn levels(&self) -> Vec<f64> {
-        let quiet = self
-            .blocks
+    /// The complete blocks, plus the trailing partial block when it holds ≥ half a block.
+    fn all_blocks(&self) -> Vec<Block> {
+        let mut b = self.blocks.clone();
+        if 2 * self.current.n >= self.block_len {
+            b.push(self.current);
+        }
+        b
+    }
+
+    /// Levels ℓ_r of the blocks (N).
+    fn levels(&self, blocks: &[Block]) -> Vec<f64> {
+        let quiet = blocks
             .iter()
             .min_by(|a, b| a.variance().total_cmp(&b.variance()))
             .map(|b| b.mean())
             .unwrap_or([0.0; 3]);
-        self.blocks
+        blocks
             .iter()
             .map(|b| {
                 let m = b.mean();
@@ -132,7 +147,12 @@ impl Envelope {
 
     /// Detect the steady cut (module doc). `fs` in Hz, `rev_s` one nominal revolution (s).
     pub fn detect(&self, fs: f64, rev_s: f64) -> Result<SteadySection, SignalError> {
-        let lv = self.levels();
+        let blocks = self.all_blocks();
+        let lv = self.levels(&blocks);
+        // block r starts at sample r·block_len; the last may be partial
+        let end_s = |r: usize| {
+            (blocks[..r].iter().map(|b| b.n).sum::<u64>()) as f64 / fs
+        };
         let block_s = self.block_len as f64 / fs;
         let no_cut = |reason: String| SignalError::NoCut { reason };
         if lv.len() < 2 {
@@ -170,7 +190,7 @@ impl Envelope {
         while b > a && off(lv[b - 1]) {
             b -= 1;
         }
-        let span_s = (b - a) as f64 * block_s;
+        let span_s = end_s(b) - end_s(a);
         if span_s < 2.0 * rev_s * (1.0 - 1e-9) {
             return Err(no_cut(format!(
                 "the longest stable run above the threshold {threshold:.3} N (air level {lo:.3} N, cutting level {hi:.3} N) \
@@ -178,9 +198,19 @@ impl Envelope {
                 2.0 * rev_s
             )));
         }
+        let air: Vec<&Block> = blocks
+            .iter()
+            .zip(&lv)
+            .filter(|(_, &l)| contrast && l <= 2.0 * lo)
+            .map(|(b, _)| b)
+            .collect();
+        let air_offset = (!air.is_empty()).then(|| {
+            let sum = air.iter().fold(Block::default(), |acc, b| Block::merge(acc, **b));
+            sum.mean()
+        });
         Ok(SteadySection {
-            from_s: a as f64 * block_s,
-            to_s: b as f64 * block_s,
+            from_s: end_s(a),
+            to_s: end_s(b),
             overridden: false,
             block_s,
             air_level: lo,
@@ -188,6 +218,7 @@ impl Envelope {
             threshold: threshold,
             trim_tolerance: tol,
             trimmed_blocks: (a - best.0) + (best.1 - b),
+            air_offset,
         })
     }
 }
@@ -213,6 +244,8 @@ mod tests {
         let s = e.detect(1000.0, 0.1).unwrap();
         assert!((s.from_s - 0.6).abs() < 1e-9 && (s.to_s - 2.6).abs() < 1e-9, "{s:?}");
         assert_eq!(s.trimmed_blocks, 0); // the entry block is below the threshold here
+        let off = s.air_offset.unwrap();
+        assert!((off[0] - 5.0).abs() < 1e-3 && (off[1] + 2.0).abs() < 1e-3 && (off[2] - 1.0).abs() < 1e-9);
     }
 
     #[test]
