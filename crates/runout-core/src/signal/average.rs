@@ -139,8 +139,16 @@ impl SyncAverage {
 }
 
 enum Marks {
-    Linear { t_ref: f64, period: f64, next: u64, last: u64 },
-    Pulse { det: EdgeDetector, to: f64 },
+    Linear {
+        t_ref: f64,
+        period: f64,
+        next: u64,
+        last: u64,
+    },
+    Pulse {
+        det: EdgeDetector,
+        to: f64,
+    },
 }
 
 /// Pass-3 accumulator: feed every chunk again, then [`SyncAverager::finish`].
@@ -172,7 +180,11 @@ pub struct SyncAverager {
 
 impl SyncAverager {
     /// Start pass 3 with the results of passes 1 and 2.
-    pub fn new(cfg: &SignalConfig, scan: &ScanResult, speed: &SpindleSpeed) -> Result<Self, SignalError> {
+    pub fn new(
+        cfg: &SignalConfig,
+        scan: &ScanResult,
+        speed: &SpindleSpeed,
+    ) -> Result<Self, SignalError> {
         cfg.validate()?;
         let fs = cfg.sample_rate_hz;
         let (from, to) = (scan.section.from_s, scan.section.to_s);
@@ -204,7 +216,11 @@ impl SyncAverager {
                 AngleReference::SectionStart { t_ref_s: from },
             ),
         };
-        let absolute_start = if cfg.absolute_teeth() { cfg.entry_angle_rad } else { None };
+        let absolute_start = if cfg.absolute_teeth() {
+            cfg.entry_angle_rad
+        } else {
+            None
+        };
         Ok(SyncAverager {
             fs,
             guard: ChunkGuard::default(),
@@ -228,14 +244,19 @@ impl SyncAverager {
             teeth: vec![RunningStats::default(); cfg.teeth],
             revs: 0,
             has_fz: scan.has_fz,
-            offset: if cfg.subtract_air_offset { scan.section.air_offset } else { None },
+            offset: if cfg.subtract_air_offset {
+                scan.section.air_offset
+            } else {
+                None
+            },
         })
     }
 
     /// Feed the next chunk.
     pub fn push(&mut self, c: Chunk) -> Result<(), SignalError> {
         let start = self.guard.next;
-        self.guard.check(&c, self.fs, matches!(self.marks, Marks::Pulse { .. }))?;
+        self.guard
+            .check(&c, self.fs, matches!(self.marks, Marks::Pulse { .. }))?;
         for i in 0..c.len() {
             let n = start + i as u64;
             if n > self.stop {
@@ -264,7 +285,12 @@ impl SyncAverager {
                 });
             }
             match &mut self.marks {
-                Marks::Linear { t_ref, period, next, last } => {
+                Marks::Linear {
+                    t_ref,
+                    period,
+                    next,
+                    last,
+                } => {
                     let mut marks = Vec::new();
                     while *next <= *last && *t_ref + *next as f64 * *period <= t {
                         marks.push(*t_ref + *next as f64 * *period);
@@ -298,7 +324,9 @@ impl SyncAverager {
             self.edges.push(te);
         }
         // keep the samples from just before the revolution start
-        let keep = ((te * self.fs).floor() as u64).saturating_sub(1).max(self.buf_start);
+        let keep = ((te * self.fs).floor() as u64)
+            .saturating_sub(1)
+            .max(self.buf_start);
         let drop = ((keep - self.buf_start) as usize).min(self.buf.len().saturating_sub(2));
         self.buf.drain(..drop);
         self.buf_start += drop as u64;
@@ -331,7 +359,9 @@ impl SyncAverager {
         let ci = self.component.index();
         let wave = &self.scratch[ci * m..(ci + 1) * m];
         if self.owner.is_none() {
-            let b0 = self.absolute_start.unwrap_or_else(|| harmonic_boundary(wave, self.k, self.origin));
+            let b0 = self
+                .absolute_start
+                .unwrap_or_else(|| harmonic_boundary(wave, self.k, self.origin));
             self.owner = Some((b0, owners(m, self.k, self.origin, b0)));
         }
         if let Some((_, owner)) = &self.owner {

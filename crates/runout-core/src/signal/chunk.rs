@@ -70,8 +70,14 @@ impl ChunkGuard {
     pub fn check(&mut self, c: &Chunk, fs: f64, want_pulse: bool) -> Result<(), SignalError> {
         let n = c.fx.len();
         let start = self.next;
-        let bad = |what: String| SignalError::Channels { sample: start, what };
-        if c.fy.len() != n || c.fz.is_some_and(|v| v.len() != n) || c.pulse.is_some_and(|v| v.len() != n) {
+        let bad = |what: String| SignalError::Channels {
+            sample: start,
+            what,
+        };
+        if c.fy.len() != n
+            || c.fz.is_some_and(|v| v.len() != n)
+            || c.pulse.is_some_and(|v| v.len() != n)
+        {
             return Err(bad(format!(
                 "channel lengths differ (fx {}, fy {}, fz {:?}, pulse {:?})",
                 n,
@@ -92,10 +98,16 @@ impl ChunkGuard {
             _ => {}
         }
         if want_pulse && c.pulse.is_none() {
-            return Err(bad("a pulse channel is configured but the chunk has none".into()));
+            return Err(bad(
+                "a pulse channel is configured but the chunk has none".into()
+            ));
         }
-        let chans: [(&'static str, Option<&[f64]>); 4] =
-            [("fx", Some(c.fx)), ("fy", Some(c.fy)), ("fz", c.fz), ("pulse", c.pulse)];
+        let chans: [(&'static str, Option<&[f64]>); 4] = [
+            ("fx", Some(c.fx)),
+            ("fy", Some(c.fy)),
+            ("fz", c.fz),
+            ("pulse", c.pulse),
+        ];
         for (name, v) in chans {
             if let Some(v) = v {
                 if let Some(i) = v.iter().position(|x| !x.is_finite()) {

@@ -57,7 +57,11 @@ impl std::str::FromStr for Component {
             "fy" => Ok(Component::Fy),
             "fz" => Ok(Component::Fz),
             "fxy" | "|fxy|" => Ok(Component::Fxy),
-            _ => Err(ParamError::new("peak_component", "one of fx, fy, fz, fxy", s)),
+            _ => Err(ParamError::new(
+                "peak_component",
+                "one of fx, fy, fz, fxy",
+                s,
+            )),
         }
     }
 }
@@ -144,7 +148,9 @@ impl SignalConfig {
             return Err(ParamError::new("teeth", "an integer in 1..=64", self.teeth).into());
         }
         if !(self.search_band > 0.0 && self.search_band < 0.5) {
-            return Err(ParamError::new("search_band", "a fraction in (0, 0.5)", self.search_band).into());
+            return Err(
+                ParamError::new("search_band", "a fraction in (0, 0.5)", self.search_band).into(),
+            );
         }
         let tp = self.tooth_passing_hz() * (1.0 + self.search_band);
         if tp >= 0.5 * self.sample_rate_hz {
@@ -180,7 +186,12 @@ impl SignalConfig {
         }
         if let Some(p) = &self.pulse {
             if p.pulses_per_rev == 0 || p.pulses_per_rev > 100_000 {
-                return Err(ParamError::new("pulses_per_rev", "an integer in 1..=100000", p.pulses_per_rev).into());
+                return Err(ParamError::new(
+                    "pulses_per_rev",
+                    "an integer in 1..=100000",
+                    p.pulses_per_rev,
+                )
+                .into());
             }
             if let Some((lo, hi)) = p.thresholds {
                 if !(lo.is_finite() && hi.is_finite() && lo < hi) {

@@ -45,7 +45,8 @@ pub enum SignalError {
     #[error(
         "spectrum inconsistent with {teeth} teeth at {rpm} rpm: expected a tooth-passing line at {expected_hz:.2} Hz \
          (search band {band_lo_hz:.2}–{band_hi_hz:.2} Hz), {finding}; the strongest line is at {strongest_hz:.2} Hz \
-         (= {strongest_as_rpm:.0} rpm if it were the tooth-passing frequency of {teeth} teeth). \
+         (= {strongest_as_rpm:.0} rpm if it were the tooth-passing frequency of {teeth} teeth, \
+         half that if it were its second harmonic). \
          Check `teeth` and `rpm`."
     )]
     SpectrumInconsistent {

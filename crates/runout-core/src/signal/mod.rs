@@ -106,6 +106,16 @@ where
             scan.tooth_passing.resolution_hz
         ));
     }
+    let (below_hz, below_rel) = scan.tooth_passing.strongest_below;
+    if below_rel > 0.1 {
+        warnings.push(format!(
+            "a line at {below_hz:.1} Hz, below the tooth-passing line at {:.1} Hz, is only {:.1} dB weaker (runout side-bands \
+             are typically ≥ 15 dB weaker): the stated {} teeth may be too many, or the runout is large",
+            scan.tooth_passing.hz,
+            -10.0 * below_rel.log10(),
+            cfg.teeth
+        ));
+    }
     if average.tooth_reference == ToothReference::Arbitrary {
         warnings.push(
             "no absolute spindle angle (pulse with tooth-0 angle and entry angle): tooth 0 is an arbitrary reference tooth".into(),
@@ -126,7 +136,11 @@ pub fn analyse(cfg: &SignalConfig, rec: Chunk<'_>) -> Result<SignalAnalysis, Sig
 
 /// Run the pipeline over a recording in memory, fed in chunks of `chunk` samples (for tests of
 /// the streaming path and for benchmarks).
-pub fn analyse_chunked(cfg: &SignalConfig, rec: Chunk<'_>, chunk: usize) -> Result<SignalAnalysis, SignalError> {
+pub fn analyse_chunked(
+    cfg: &SignalConfig,
+    rec: Chunk<'_>,
+    chunk: usize,
+) -> Result<SignalAnalysis, SignalError> {
     let step = chunk.max(1);
     analyse_replay(cfg, |sink: &mut ChunkSink<'_>| {
         (0..rec.len())

@@ -36,7 +36,11 @@ impl EdgeDetector {
         if self.armed && v >= self.hi {
             self.armed = false;
             let (tp, vp) = prev?;
-            let w = if v > vp { ((self.hi - vp) / (v - vp)).clamp(0.0, 1.0) } else { 1.0 };
+            let w = if v > vp {
+                ((self.hi - vp) / (v - vp)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
             return Some(tp + w * (t - tp));
         }
         None
@@ -68,7 +72,7 @@ impl Range {
     /// Thresholds at 30 % and 70 % of the range, or None when the channel is flat.
     pub fn thresholds(&self) -> Option<(f64, f64)> {
         let d = self.max - self.min;
-        (d > 0.0 && d.is_finite()).then(|| (self.min + 0.3 * d, self.min + 0.7 * d))
+        (d > 0.0 && d.is_finite()).then_some((self.min + 0.3 * d, self.min + 0.7 * d))
     }
 }
 
@@ -80,7 +84,15 @@ mod tests {
     fn edge_time_is_interpolated_and_noise_is_ignored() {
         let mut d = EdgeDetector::new(0.3, 0.7);
         // ramp from 0 to 1 between t = 1 and t = 2: the 0.7 crossing is at t = 1.7
-        let samples = [(0.0, 0.0), (1.0, 0.0), (2.0, 1.0), (3.0, 0.6), (4.0, 0.9), (5.0, 0.1), (6.0, 0.8)];
+        let samples = [
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (2.0, 1.0),
+            (3.0, 0.6),
+            (4.0, 0.9),
+            (5.0, 0.1),
+            (6.0, 0.8),
+        ];
         let edges: Vec<f64> = samples.iter().filter_map(|&(t, v)| d.push(t, v)).collect();
         // the dip to 0.6 stays above 0.3: no re-arm, no edge at t = 4
         assert_eq!(edges.len(), 2);

@@ -53,7 +53,8 @@ impl SpindleScan {
 
     /// Feed the next chunk.
     pub fn push(&mut self, c: Chunk) -> Result<(), SignalError> {
-        self.guard.check(&c, self.cfg.sample_rate_hz, self.cfg.pulse.is_some())?;
+        self.guard
+            .check(&c, self.cfg.sample_rate_hz, self.cfg.pulse.is_some())?;
         for i in 0..c.len() {
             let f = c.force(i);
             self.welch.push(f[0], f[1]);
@@ -81,23 +82,31 @@ impl SpindleScan {
             });
         }
         self.welch.finish();
-        let line = self.welch.tooth_passing(cfg.teeth, cfg.nominal_rpm, cfg.search_band)?;
+        let line = self
+            .welch
+            .tooth_passing(cfg.teeth, cfg.nominal_rpm, cfg.search_band)?;
         let coarse = line.hz / cfg.teeth as f64;
         let section = match cfg.section_s {
             Some((a, b)) => {
                 let mut s = override_section(a, b, duration_s, 60.0 / cfg.nominal_rpm)?;
-                s.air_offset = self.envelope.detect(fs, 60.0 / cfg.nominal_rpm).ok().and_then(|d| d.air_offset);
+                s.air_offset = self
+                    .envelope
+                    .detect(fs, 60.0 / cfg.nominal_rpm)
+                    .ok()
+                    .and_then(|d| d.air_offset);
                 s
             }
             None => self.envelope.detect(fs, 60.0 / cfg.nominal_rpm)?,
         };
         let pulse_thresholds = match cfg.pulse {
             None => None,
-            Some(p) => Some(p.thresholds.or(self.pulse.thresholds()).ok_or_else(|| SignalError::Pulse {
-                reason: format!(
-                    "the channel is flat (min {} = max {}): no edges",
-                    self.pulse.min, self.pulse.max
-                ),
+            Some(p) => Some(p.thresholds.or(self.pulse.thresholds()).ok_or_else(|| {
+                SignalError::Pulse {
+                    reason: format!(
+                        "the channel is flat (min {} = max {}): no edges",
+                        self.pulse.min, self.pulse.max
+                    ),
+                }
             })?),
         };
         Ok(ScanResult {
@@ -112,7 +121,12 @@ impl SpindleScan {
     }
 }
 
-fn override_section(a: f64, b: f64, duration: f64, rev_s: f64) -> Result<SteadySection, SignalError> {
+fn override_section(
+    a: f64,
+    b: f64,
+    duration: f64,
+    rev_s: f64,
+) -> Result<SteadySection, SignalError> {
     if b > duration + 1e-9 {
         return Err(crate::error::ParamError::new(
             "to_s",

@@ -45,6 +45,11 @@ pub struct ToothPassingLine {
     /// Frames averaged (0 when the record was shorter than one frame and analysed as one
     /// zero-padded partial frame).
     pub frames: usize,
+    /// Strongest spindle harmonic j·f (j = 1..K−1) below the tooth-passing line: (Hz, power
+    /// relative to the line). Above 0.1 (−10 dB) suggests fewer teeth than stated (K/d teeth put
+    /// their tooth-passing line on harmonic K/d), or a large runout (runout side-bands are typically
+    /// 15–25 dB weaker).
+    pub strongest_below: (f64, f64),
 }
 
 impl Welch {
@@ -120,7 +125,12 @@ impl Welch {
     /// is ≥ 10 % of the strongest line above half the spindle frequency (−10 dB) and (c) it
     /// stands ≥ 4× above the median power in expected·[0.5, 1.5]. Otherwise the spectrum is
     /// inconsistent with the stated teeth or rpm.
-    pub fn tooth_passing(&self, teeth: usize, rpm: f64, band: f64) -> Result<ToothPassingLine, SignalError> {
+    pub fn tooth_passing(
+        &self,
+        teeth: usize,
+        rpm: f64,
+        band: f64,
+    ) -> Result<ToothPassingLine, SignalError> {
         let expected = teeth as f64 * rpm / 60.0;
         let df = self.bin_hz();
         let nb = self.psd.len();
@@ -143,19 +153,22 @@ impl Welch {
             strongest_hz: strongest as f64 * df,
             strongest_as_rpm: strongest as f64 * df * 60.0 / teeth as f64,
         };
-        if !(p_max > 0.0) {
+        if p_max.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return Err(fail("the signal has no variation (flat spectrum)".into()));
         }
         let k = argmax(lo, hi);
         let p = self.psd[k];
-        if k == 0 || k + 1 >= nb || self.psd[k - 1] > p || self.psd[k + 1] > p || k == lo || k == hi {
-            return Err(fail("the largest value in the band is at its edge, not a peak".into()));
+        if k == 0 || k + 1 >= nb || self.psd[k - 1] > p || self.psd[k + 1] > p || k == lo || k == hi
+        {
+            return Err(fail(
+                "the largest value in the band is at its edge, not a peak".into(),
+            ));
         }
         let rel = p / p_max;
         if rel < 0.1 {
             return Err(fail(format!(
-                "the largest peak in the band is {:.1} dB below the strongest line (limit −10 dB)",
-                10.0 * rel.log10()
+                "the largest peak in the band is {:.1} dB below the strongest line (limit 10 dB)",
+                -10.0 * rel.log10()
             )));
         }
         let ctx = &self.psd[bin(0.5 * expected)..=bin(1.5 * expected)];
@@ -167,12 +180,26 @@ impl Welch {
         }
         let l = |i: usize| self.psd[i].max(f64::MIN_POSITIVE).ln();
         let (d, _) = parabolic_peak(l(k - 1), l(k), l(k + 1));
+        let hz = (k as f64 + d) * df;
+        // spindle harmonics j·f below the tooth-passing line (j = 1..K−1), ± half an un-padded bin
+        let below = (1..teeth)
+            .map(|j| {
+                let c = j as f64 * hz / teeth as f64;
+                let (a, b) = (
+                    bin(c) - (PAD / 2).min(bin(c)),
+                    (bin(c) + PAD / 2).min(nb - 1),
+                );
+                let q = argmax(a, b);
+                (q as f64 * df, self.psd[q] / p)
+            })
+            .fold((0.0, 0.0), |m, x| if x.1 > m.1 { x } else { m });
         Ok(ToothPassingLine {
-            hz: (k as f64 + d) * df,
+            hz,
             relative_power: rel,
             prominence,
             resolution_hz: self.fs / self.frame as f64,
             frames: self.frames,
+            strongest_below: below,
         })
     }
 }
@@ -194,8 +221,15 @@ mod tests {
         // K = 5 at 6000 rpm → 500 Hz expected
         let line = w.tooth_passing(5, 6000.0, 0.1).unwrap();
         // un-padded bin = 10 kHz/1024 ≈ 9.8 Hz; ×4 padding + log-parabola: error < 0.05 bin
-        assert!((line.hz - f0).abs() < 0.05 * line.resolution_hz, "{}", line.hz);
+        assert!(
+            (line.hz - f0).abs() < 0.05 * line.resolution_hz,
+            "{}",
+            line.hz
+        );
         // wrong teeth: 4 teeth at 6000 rpm → 400 Hz, nothing there
-        assert!(matches!(w.tooth_passing(4, 6000.0, 0.1), Err(SignalError::SpectrumInconsistent { .. })));
+        assert!(matches!(
+            w.tooth_passing(4, 6000.0, 0.1),
+            Err(SignalError::SpectrumInconsistent { .. })
+        ));
     }
 }

@@ -67,7 +67,7 @@ pub(crate) fn quantile(v: &[f64], q: f64) -> f64 {
 /// points are not concave.
 pub(crate) fn parabolic_peak(a: f64, b: f64, c: f64) -> (f64, f64) {
     let den = a - 2.0 * b + c;
-    if !(den < 0.0) {
+    if den.partial_cmp(&0.0) != Some(std::cmp::Ordering::Less) {
         return (0.0, b);
     }
     let d = (0.5 * (a - c) / den).clamp(-0.5, 0.5);

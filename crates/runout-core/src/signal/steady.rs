@@ -49,7 +49,9 @@ impl Block {
     fn variance(&self) -> f64 {
         let n = self.n.max(1) as f64;
         let m = self.mean();
-        (0..3).map(|i| (self.sq[i] / n - m[i] * m[i]).max(0.0)).sum()
+        (0..3)
+            .map(|i| (self.sq[i] / n - m[i] * m[i]).max(0.0))
+            .sum()
     }
 }
 
@@ -106,14 +108,18 @@ impl Envelope {
     pub fn push(&mut self, f: [f64; 3]) {
         let c = &mut self.current;
         c.n += 1;
-        for i in 0..3 {
-            c.sum[i] += f[i];
-            c.sq[i] += f[i] * f[i];
+        for (i, &x) in f.iter().enumerate() {
+            c.sum[i] += x;
+            c.sq[i] += x * x;
         }
         if c.n == self.block_len {
             self.blocks.push(std::mem::take(c));
             if self.blocks.len() == MAX_BLOCKS {
-                self.blocks = self.blocks.chunks(2).map(|p| Block::merge(p[0], p[1])).collect();
+                self.blocks = self
+                    .blocks
+                    .chunks(2)
+                    .map(|p| Block::merge(p[0], p[1]))
+                    .collect();
                 self.block_len *= 2;
             }
         }
@@ -150,23 +156,30 @@ impl Envelope {
         let blocks = self.all_blocks();
         let lv = self.levels(&blocks);
         // block r starts at sample r·block_len; the last may be partial
-        let end_s = |r: usize| {
-            (blocks[..r].iter().map(|b| b.n).sum::<u64>()) as f64 / fs
-        };
+        let end_s = |r: usize| (blocks[..r].iter().map(|b| b.n).sum::<u64>()) as f64 / fs;
         let block_s = self.block_len as f64 / fs;
         let no_cut = |reason: String| SignalError::NoCut { reason };
         if lv.len() < 2 {
-            return Err(no_cut(format!("only {} complete revolution(s) of data", lv.len())));
+            return Err(no_cut(format!(
+                "only {} complete revolution(s) of data",
+                lv.len()
+            )));
         }
         let (lo, hi) = (quantile(&lv, 0.05), quantile(&lv, 0.95));
-        if !(hi > 0.0) {
-            return Err(no_cut("the force is constant (zero variation in every revolution)".into()));
+        if hi.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return Err(no_cut(
+                "the force is constant (zero variation in every revolution)".into(),
+            ));
         }
         let contrast = hi >= 2.0 * lo;
         let threshold = if contrast { 0.5 * (lo + hi) } else { 0.0 };
         // longest run at or above the threshold
         let (mut best, mut start) = ((0usize, 0usize), None);
-        for (r, &l) in lv.iter().chain(std::iter::once(&f64::NEG_INFINITY)).enumerate() {
+        for (r, &l) in lv
+            .iter()
+            .chain(std::iter::once(&f64::NEG_INFINITY))
+            .enumerate()
+        {
             match (l >= threshold, start) {
                 (true, None) => start = Some(r),
                 (false, Some(s)) => {
@@ -205,7 +218,9 @@ impl Envelope {
             .map(|(b, _)| b)
             .collect();
         let air_offset = (!air.is_empty()).then(|| {
-            let sum = air.iter().fold(Block::default(), |acc, b| Block::merge(acc, **b));
+            let sum = air
+                .iter()
+                .fold(Block::default(), |acc, b| Block::merge(acc, **b));
             sum.mean()
         });
         Ok(SteadySection {
@@ -215,7 +230,7 @@ impl Envelope {
             block_s,
             air_level: lo,
             cut_level: median(&lv[a..b]),
-            threshold: threshold,
+            threshold,
             trim_tolerance: tol,
             trimmed_blocks: (a - best.0) + (best.1 - b),
             air_offset,
@@ -242,10 +257,17 @@ mod tests {
         feed(&mut e, 20, 100, 10.0);
         feed(&mut e, 4, 100, 0.01);
         let s = e.detect(1000.0, 0.1).unwrap();
-        assert!((s.from_s - 0.6).abs() < 1e-9 && (s.to_s - 2.6).abs() < 1e-9, "{s:?}");
+        assert!(
+            (s.from_s - 0.6).abs() < 1e-9 && (s.to_s - 2.6).abs() < 1e-9,
+            "{s:?}"
+        );
         assert_eq!(s.trimmed_blocks, 0); // the entry block is below the threshold here
         let off = s.air_offset.unwrap();
-        assert!((off[0] - 5.0).abs() < 1e-3 && (off[1] + 2.0).abs() < 1e-3 && (off[2] - 1.0).abs() < 1e-9);
+        assert!(
+            (off[0] - 5.0).abs() < 1e-3
+                && (off[1] + 2.0).abs() < 1e-3
+                && (off[2] - 1.0).abs() < 1e-9
+        );
     }
 
     #[test]
@@ -263,6 +285,9 @@ mod tests {
         for _ in 0..10 * 100 {
             e.push([1.0, 2.0, 3.0]);
         }
-        assert!(matches!(e.detect(1000.0, 0.1), Err(SignalError::NoCut { .. })));
+        assert!(matches!(
+            e.detect(1000.0, 0.1),
+            Err(SignalError::NoCut { .. })
+        ));
     }
 }

@@ -294,10 +294,24 @@ impl PhaseTracker {
                 if fit.n >= 3.0 {
                     let (slope, se, rms) = fit.solve();
                     let f = (*f_tp + slope / TAU) / k;
-                    (SpeedMethod::PhaseTracking, f, se / TAU / k, fit.n as usize, rms, None)
+                    (
+                        SpeedMethod::PhaseTracking,
+                        f,
+                        se / TAU / k,
+                        fit.n as usize,
+                        rms,
+                        None,
+                    )
                 } else {
                     let se = self.resolution_hz / (k * 12f64.sqrt());
-                    (SpeedMethod::Spectrum, self.coarse_hz, se, fit.n as usize, f64::NAN, None)
+                    (
+                        SpeedMethod::Spectrum,
+                        self.coarse_hz,
+                        se,
+                        fit.n as usize,
+                        f64::NAN,
+                        None,
+                    )
                 }
             }
             Mode::Pulse {
@@ -323,12 +337,21 @@ impl PhaseTracker {
                 let (slope, se_slope, rms) = fit.solve();
                 let f = 1.0 / (*per_rev as f64 * slope);
                 let variation = periods.sd() / periods.mean();
-                (SpeedMethod::Pulse, f, f * se_slope / slope, *edges as usize, rms, Some(variation))
+                (
+                    SpeedMethod::Pulse,
+                    f,
+                    f * se_slope / slope,
+                    *edges as usize,
+                    rms,
+                    Some(variation),
+                )
             }
         };
         if !(hz.is_finite() && hz > 0.0) {
             return Err(SignalError::NoCut {
-                reason: format!("the spindle speed could not be measured in the section (got {hz} Hz)"),
+                reason: format!(
+                    "the spindle speed could not be measured in the section (got {hz} Hz)"
+                ),
             });
         }
         let rpm = 60.0 * hz;
