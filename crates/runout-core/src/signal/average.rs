@@ -5,7 +5,7 @@
 //! encoder) is resampled at M uniform spindle-angle bins θ_j = θ_origin + 2πj/M by linear
 //! interpolation between the neighbouring samples. Per bin and component (F_x, F_y, F_z, |F_xy|,
 //! |F_xy| computed from the interpolated F_x, F_y) the mean, the revolution-to-revolution
-//! standard deviation and the standard error sd/√n are accumulated (Welford).
+//! standard deviation and the standard error sd/√n are accumulated (shifted sums).
 //!
 //! **Tooth periods** (`force::tooth_peaks`): tooth i owns θ ∈ [b₀ + 2πi/K, b₀ + 2π(i+1)/K).
 //! Absolute (pulse with tooth-0 angle and the entry angle φ_st): b₀ = φ_st, exactly as in
@@ -26,7 +26,7 @@
 use super::chunk::ChunkGuard;
 use super::pulse::EdgeDetector;
 use super::scan::ScanResult;
-use super::stats::{parabolic_peak, RunningStats};
+use super::stats::{parabolic_peak, RunningStats, ShiftedSums};
 use super::tracker::SpindleSpeed;
 use super::{Chunk, Component, SignalConfig, SignalError};
 use crate::angle::wrap_tau;
@@ -169,7 +169,7 @@ pub struct SyncAverager {
     buf_start: u64,
     edges: Vec<f64>,
     max_buf: usize,
-    acc: Vec<RunningStats>,
+    acc: Vec<ShiftedSums>,
     scratch: Vec<f64>,
     owner: Option<(f64, Vec<usize>)>,
     teeth: Vec<RunningStats>,
@@ -238,7 +238,7 @@ impl SyncAverager {
             buf_start: 0,
             edges: Vec::with_capacity(per_rev + 1),
             max_buf: (4.0 * period.max(60.0 / cfg.nominal_rpm) * fs) as usize + 16,
-            acc: vec![RunningStats::default(); 4 * m],
+            acc: vec![ShiftedSums::default(); 4 * m],
             scratch: vec![0.0; 4 * m],
             owner: None,
             teeth: vec![RunningStats::default(); cfg.teeth],
@@ -257,63 +257,83 @@ impl SyncAverager {
         let start = self.guard.next;
         self.guard
             .check(&c, self.fs, matches!(self.marks, Marks::Pulse { .. }))?;
-        for i in 0..c.len() {
-            let n = start + i as u64;
-            if n > self.stop {
-                break;
+        let len = (self.stop + 1).saturating_sub(start).min(c.len() as u64) as usize;
+        let mut i = 0;
+        while i < len {
+            if let Marks::Linear {
+                t_ref,
+                period,
+                next,
+                last,
+            } = self.marks
+            {
+                // append up to and including the first sample after the next mark, in bulk
+                let te = (next <= last).then(|| t_ref + next as f64 * period);
+                let ne = te.map_or(u64::MAX, |te| (te * self.fs).floor() as u64 + 1);
+                let seg_end = (ne.saturating_sub(start).saturating_add(1)).min(len as u64) as usize;
+                let seg_end = seg_end.max(i + 1);
+                self.append(&c, i, seg_end, start);
+                i = seg_end;
+                if let Some(te) = te {
+                    if ne < start + i as u64 {
+                        if let Marks::Linear { next, .. } = &mut self.marks {
+                            *next += 1;
+                        }
+                        self.on_edge(te);
+                    }
+                }
+            } else {
+                let n = start + i as u64;
+                let t = n as f64 / self.fs;
+                let v = c.pulse.map_or(0.0, |p| p[i]);
+                let (edge, to) = match &mut self.marks {
+                    Marks::Pulse { det, to } => (det.push(t, v), *to),
+                    Marks::Linear { .. } => (None, f64::INFINITY),
+                };
+                self.append(&c, i, i + 1, start);
+                i += 1;
+                if let Some(te) = edge {
+                    if te > to {
+                        self.edges.clear();
+                        self.stop = n;
+                        break;
+                    } else if te >= self.from {
+                        self.on_edge(te);
+                    }
+                }
             }
-            let t = n as f64 / self.fs;
-            if self.edges.is_empty() && self.buf.len() >= 2 {
-                self.buf.remove(0);
-                self.buf_start += 1;
-            }
-            if self.buf.is_empty() {
-                self.buf_start = n;
-            }
-            let mut f = c.force(i);
-            if let Some(o) = self.offset {
-                f = [f[0] - o[0], f[1] - o[1], f[2] - o[2]];
-            }
-            self.buf.push(f);
             if self.buf.len() > self.max_buf {
                 return Err(SignalError::Pulse {
                     reason: format!(
                         "no revolution mark between {:.6} s and {:.6} s (more than 4 revolutions): the pulse is missing or the speed is wrong",
                         self.buf_start as f64 / self.fs,
-                        t
+                        (start + i as u64) as f64 / self.fs
                     ),
                 });
             }
-            match &mut self.marks {
-                Marks::Linear {
-                    t_ref,
-                    period,
-                    next,
-                    last,
-                } => {
-                    let mut marks = Vec::new();
-                    while *next <= *last && *t_ref + *next as f64 * *period <= t {
-                        marks.push(*t_ref + *next as f64 * *period);
-                        *next += 1;
-                    }
-                    for te in marks {
-                        self.on_edge(te);
-                    }
-                }
-                Marks::Pulse { det, to } => {
-                    let v = c.pulse.map_or(0.0, |p| p[i]);
-                    if let Some(te) = det.push(t, v) {
-                        if te > *to {
-                            self.edges.clear();
-                            self.stop = n;
-                        } else if te >= self.from {
-                            self.on_edge(te);
-                        }
-                    }
-                }
-            }
         }
         Ok(())
+    }
+
+    /// Append samples `i0..i1` of `c` (global index `start + i`) to the buffer, offset removed.
+    /// Outside a revolution only the last two samples are kept.
+    fn append(&mut self, c: &Chunk, i0: usize, i1: usize, start: u64) {
+        let mut i0 = i0;
+        if self.edges.is_empty() {
+            i0 = i0.max(i1.saturating_sub(2));
+            let total = self.buf.len() + (i1 - i0);
+            let d = total.saturating_sub(2).min(self.buf.len());
+            self.buf.drain(..d);
+            self.buf_start += d as u64;
+        }
+        if self.buf.is_empty() {
+            self.buf_start = start + i0 as u64;
+        }
+        let o = self.offset.unwrap_or([0.0; 3]);
+        self.buf.extend((i0..i1).map(|i| {
+            let f = c.force(i);
+            [f[0] - o[0], f[1] - o[1], f[2] - o[2]]
+        }));
     }
 
     fn on_edge(&mut self, te: f64) {

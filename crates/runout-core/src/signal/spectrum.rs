@@ -2,7 +2,8 @@
 //!
 //! Non-overlapping frames of L samples (L = the power of two ≥ 8 nominal revolutions, at most
 //! 2¹⁶), mean removed, Hann window, zero-padded ×4, real FFT (`realfft`); power spectra of F_x and
-//! F_y summed and averaged over frames. A record shorter than one frame is analysed as one
+//! F_y summed over frames (all of the first 64 frames, then a thinning subset: see
+//! `transformed`). A record shorter than one frame is analysed as one
 //! zero-padded partial frame. The tooth-passing line is the largest bin within
 //! K·n/60·(1 ± band), refined by a parabola through the log-power of the bin and its neighbours
 //! (quadratic interpolation of a Hann-windowed peak; bias ≪ 0.01 bin with ×4 zero padding).
@@ -28,7 +29,26 @@ pub(crate) struct Welch {
     input: Vec<f64>,
     output: Vec<realfft::num_complex::Complex<f64>>,
     psd: Vec<f64>,
+    window: Vec<f64>,
     frames: usize,
+    /// Frames started (transformed or skipped).
+    seen: usize,
+    /// Samples of the current frame when it is skipped.
+    skipped_fill: usize,
+}
+
+/// Whether frame `i` is transformed: all of the first 64, then every ⌊i/64⌋+1-th, so about
+/// 64·(1 + ln(N/64)) of N frames cost an FFT (the spectrum only has to locate the line; the
+/// phase tracker refines the frequency). Deterministic, hence independent of chunking.
+fn transformed(i: usize) -> bool {
+    i < 64 || i % (i / 64 + 1) == 0
+}
+
+/// Hann window of length `len` (periodic-symmetric at sample centres).
+fn hann(len: usize) -> Vec<f64> {
+    (0..len)
+        .map(|i| 0.5 - 0.5 * (2.0 * PI * (i as f64 + 0.5) / len as f64).cos())
+        .collect()
 }
 
 /// The tooth-passing line found in the spectrum.
@@ -70,29 +90,47 @@ impl Welch {
             input,
             output,
             psd: vec![0.0; n / 2 + 1],
+            window: hann(frame),
             frames: 0,
+            seen: 0,
+            skipped_fill: 0,
         }
     }
 
     /// Add one sample of F_x, F_y.
     #[inline]
     pub fn push(&mut self, fx: f64, fy: f64) {
+        if !transformed(self.seen) {
+            self.skipped_fill += 1;
+            if self.skipped_fill == self.frame {
+                self.skipped_fill = 0;
+                self.seen += 1;
+            }
+            return;
+        }
         self.buf[0].push(fx);
         self.buf[1].push(fy);
         if self.buf[0].len() == self.frame {
             self.transform();
             self.frames += 1;
+            self.seen += 1;
         }
     }
 
     fn transform(&mut self) {
         let len = self.buf[0].len();
+        let partial;
+        let window = if len == self.frame {
+            &self.window
+        } else {
+            partial = hann(len);
+            &partial
+        };
         for c in 0..2 {
             let b = &self.buf[c];
             let mean = b.iter().sum::<f64>() / len as f64;
             self.input.iter_mut().for_each(|v| *v = 0.0);
-            for (i, (dst, &x)) in self.input.iter_mut().zip(b).enumerate() {
-                let w = 0.5 - 0.5 * (2.0 * PI * (i as f64 + 0.5) / len as f64).cos();
+            for ((dst, &x), &w) in self.input.iter_mut().zip(b).zip(window) {
                 *dst = (x - mean) * w;
             }
             // the plan and buffers are sized together: process cannot fail

@@ -43,6 +43,51 @@ impl RunningStats {
     }
 }
 
+/// Running mean and variance by shifted sums: the first value K is the shift, then Σ(x−K) and
+/// Σ(x−K)² (no division per value, unlike Welford; with the shift the cancellation in
+/// Σ(x−K)² − (Σ(x−K))²/n is that of the spread around K, not around 0).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct ShiftedSums {
+    n: u64,
+    shift: f64,
+    s1: f64,
+    s2: f64,
+}
+
+impl ShiftedSums {
+    #[inline]
+    pub fn push(&mut self, x: f64) {
+        if self.n == 0 {
+            self.shift = x;
+        }
+        let d = x - self.shift;
+        self.n += 1;
+        self.s1 += d;
+        self.s2 += d * d;
+    }
+    pub fn mean(&self) -> f64 {
+        if self.n == 0 {
+            0.0
+        } else {
+            self.shift + self.s1 / self.n as f64
+        }
+    }
+    pub fn sd(&self) -> f64 {
+        if self.n < 2 {
+            return 0.0;
+        }
+        let n = self.n as f64;
+        ((self.s2 - self.s1 * self.s1 / n).max(0.0) / (n - 1.0)).sqrt()
+    }
+    pub fn se(&self) -> f64 {
+        if self.n < 2 {
+            0.0
+        } else {
+            self.sd() / (self.n as f64).sqrt()
+        }
+    }
+}
+
 /// Median of a slice (NaN when empty); the slice is copied.
 pub(crate) fn median(v: &[f64]) -> f64 {
     quantile(v, 0.5)
@@ -88,6 +133,19 @@ mod tests {
         assert!((s.mean() - m).abs() < 1e-12);
         assert!((s.sd() - var.sqrt()).abs() < 1e-12);
         assert!((s.se() - (var / 5.0).sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn shifted_sums_match_welford_with_a_large_mean() {
+        let v: Vec<f64> = (0..1000).map(|i| 1e6 + (i as f64 * 0.7).sin()).collect();
+        let (mut a, mut b) = (RunningStats::default(), ShiftedSums::default());
+        v.iter().for_each(|&x| {
+            a.push(x);
+            b.push(x)
+        });
+        assert!((a.mean() - b.mean()).abs() < 1e-9);
+        assert!((a.sd() - b.sd()).abs() < 1e-9 * a.sd());
+        assert!((a.se() - b.se()).abs() < 1e-9 * a.se());
     }
 
     #[test]

@@ -118,6 +118,7 @@ impl LineFit {
 enum Mode {
     Phase {
         f_tp: f64,
+        /// Coarse revolutions per second (block index = ⌊(t − t₀)·f̂⌋).
         rev_s: f64,
         blocks: u64,
         block: Option<u64>,
@@ -173,7 +174,7 @@ impl PhaseTracker {
                 let dt = 1.0 / cfg.sample_rate_hz;
                 Mode::Phase {
                     f_tp,
-                    rev_s: 1.0 / coarse,
+                    rev_s: coarse,
                     blocks: ((to - from) * coarse).floor().max(0.0) as u64,
                     block: None,
                     acc: (0.0, 0.0),
@@ -224,7 +225,7 @@ impl PhaseTracker {
                     if rel < 0.0 {
                         continue;
                     }
-                    let b = (rel / *rev_s).floor() as u64;
+                    let b = (rel * *rev_s).floor() as u64;
                     if b >= *blocks {
                         break;
                     }
