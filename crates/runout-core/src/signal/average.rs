@@ -26,7 +26,7 @@
 use super::chunk::ChunkGuard;
 use super::pulse::EdgeDetector;
 use super::scan::ScanResult;
-use super::stats::{parabolic_peak, RunningStats, ShiftedSums};
+use super::stats::{parabolic_peak, BinStats, RunningStats};
 use super::tracker::SpindleSpeed;
 use super::{Chunk, Component, SignalConfig, SignalError};
 use crate::angle::wrap_tau;
@@ -169,7 +169,7 @@ pub struct SyncAverager {
     buf_start: u64,
     edges: Vec<f64>,
     max_buf: usize,
-    acc: Vec<ShiftedSums>,
+    acc: BinStats,
     scratch: Vec<f64>,
     owner: Option<(f64, Vec<usize>)>,
     teeth: Vec<RunningStats>,
@@ -238,7 +238,7 @@ impl SyncAverager {
             buf_start: 0,
             edges: Vec::with_capacity(per_rev + 1),
             max_buf: (4.0 * period.max(60.0 / cfg.nominal_rpm) * fs) as usize + 16,
-            acc: vec![ShiftedSums::default(); 4 * m],
+            acc: BinStats::new(4 * m),
             scratch: vec![0.0; 4 * m],
             owner: None,
             teeth: vec![RunningStats::default(); cfg.teeth],
@@ -356,26 +356,31 @@ impl SyncAverager {
     fn revolution(&mut self) {
         let (m, n_e) = (self.m, self.per_rev);
         let last = self.buf.len() - 1;
-        for j in 0..m {
-            let u = (j * n_e) as f64 / m as f64;
-            let q = (u.floor() as usize).min(n_e - 1);
-            let t = self.edges[q] + (u - q as f64) * (self.edges[q + 1] - self.edges[q]);
-            let x = (t * self.fs - self.buf_start as f64).clamp(0.0, last as f64);
-            let i = (x.floor() as usize).min(last);
-            let w = x - i as f64;
-            let (a, b) = (self.buf[i], self.buf[(i + 1).min(last)]);
-            let f = [
-                a[0] + w * (b[0] - a[0]),
-                a[1] + w * (b[1] - a[1]),
-                a[2] + w * (b[2] - a[2]),
-            ];
-            for c in Component::ALL {
-                self.scratch[c.index() * m + j] = c.of(f);
+        let (lastf, base) = (last as f64, self.buf_start as f64);
+        let (sx, rest) = self.scratch.split_at_mut(m);
+        let (sy, rest) = rest.split_at_mut(m);
+        let (sz, sxy) = rest.split_at_mut(m);
+        // bins j ∈ [⌈qM/N⌉, ⌈(q+1)M/N⌉) lie between edges q and q+1 (angle linear in time there)
+        for q in 0..n_e {
+            let (j0, j1) = ((q * m).div_ceil(n_e), ((q + 1) * m).div_ceil(n_e));
+            let x0 = self.edges[q] * self.fs - base;
+            let dx = (self.edges[q + 1] - self.edges[q]) * self.fs;
+            let step = n_e as f64 / m as f64;
+            for j in j0..j1 {
+                let u = j as f64 * step - q as f64;
+                let x = (x0 + u * dx).clamp(0.0, lastf);
+                let i = (x as usize).min(last);
+                let w = x - i as f64;
+                let (a, b) = (self.buf[i], self.buf[(i + 1).min(last)]);
+                let f0 = a[0] + w * (b[0] - a[0]);
+                let f1 = a[1] + w * (b[1] - a[1]);
+                sx[j] = f0;
+                sy[j] = f1;
+                sz[j] = a[2] + w * (b[2] - a[2]);
+                sxy[j] = Component::Fxy.of([f0, f1, 0.0]);
             }
         }
-        for (a, &x) in self.acc.iter_mut().zip(&self.scratch) {
-            a.push(x);
-        }
+        self.acc.push(&self.scratch);
         let ci = self.component.index();
         let wave = &self.scratch[ci * m..(ci + 1) * m];
         if self.owner.is_none() {
@@ -406,12 +411,12 @@ impl SyncAverager {
         let components: Vec<ComponentAverage> = Component::ALL
             .iter()
             .map(|&c| {
-                let a = &self.acc[c.index() * m..(c.index() + 1) * m];
+                let bins = c.index() * m..(c.index() + 1) * m;
                 ComponentAverage {
                     component: c,
-                    mean: a.iter().map(|s| s.mean()).collect(),
-                    sd: a.iter().map(|s| s.sd()).collect(),
-                    se: a.iter().map(|s| s.se()).collect(),
+                    mean: bins.clone().map(|i| self.acc.mean(i)).collect(),
+                    sd: bins.clone().map(|i| self.acc.sd(i)).collect(),
+                    se: bins.map(|i| self.acc.se(i)).collect(),
                 }
             })
             .collect();

@@ -43,47 +43,62 @@ impl RunningStats {
     }
 }
 
-/// Running mean and variance by shifted sums: the first value K is the shift, then Σ(x−K) and
-/// Σ(x−K)² (no division per value, unlike Welford; with the shift the cancellation in
-/// Σ(x−K)² − (Σ(x−K))²/n is that of the spread around K, not around 0).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct ShiftedSums {
+/// Running mean and variance of many quantities observed together (one value each per
+/// update, e.g. the bins of a revolution), by shifted sums: the first values K are the shifts,
+/// then Σ(x−K) and Σ(x−K)² (no division per value, unlike Welford, and vectorisable; with the
+/// shift the cancellation in Σ(x−K)² − (Σ(x−K))²/n is that of the spread around K, not around 0).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct BinStats {
     n: u64,
-    shift: f64,
-    s1: f64,
-    s2: f64,
+    shift: Vec<f64>,
+    s1: Vec<f64>,
+    s2: Vec<f64>,
 }
 
-impl ShiftedSums {
-    #[inline]
-    pub fn push(&mut self, x: f64) {
-        if self.n == 0 {
-            self.shift = x;
+impl BinStats {
+    /// Statistics of `len` quantities.
+    pub fn new(len: usize) -> Self {
+        BinStats {
+            n: 0,
+            shift: vec![0.0; len],
+            s1: vec![0.0; len],
+            s2: vec![0.0; len],
         }
-        let d = x - self.shift;
-        self.n += 1;
-        self.s1 += d;
-        self.s2 += d * d;
     }
-    pub fn mean(&self) -> f64 {
+    /// Add one observation of every quantity (`x.len()` = len).
+    pub fn push(&mut self, x: &[f64]) {
+        if self.n == 0 {
+            self.shift.copy_from_slice(x);
+        }
+        for (((s1, s2), &k), &v) in self.s1.iter_mut().zip(&mut self.s2).zip(&self.shift).zip(x) {
+            let d = v - k;
+            *s1 += d;
+            *s2 += d * d;
+        }
+        self.n += 1;
+    }
+    /// Mean of quantity i.
+    pub fn mean(&self, i: usize) -> f64 {
         if self.n == 0 {
             0.0
         } else {
-            self.shift + self.s1 / self.n as f64
+            self.shift[i] + self.s1[i] / self.n as f64
         }
     }
-    pub fn sd(&self) -> f64 {
+    /// Sample standard deviation of quantity i (0 when n < 2).
+    pub fn sd(&self, i: usize) -> f64 {
         if self.n < 2 {
             return 0.0;
         }
         let n = self.n as f64;
-        ((self.s2 - self.s1 * self.s1 / n).max(0.0) / (n - 1.0)).sqrt()
+        ((self.s2[i] - self.s1[i] * self.s1[i] / n).max(0.0) / (n - 1.0)).sqrt()
     }
-    pub fn se(&self) -> f64 {
+    /// Standard error of the mean of quantity i, sd/√n.
+    pub fn se(&self, i: usize) -> f64 {
         if self.n < 2 {
             0.0
         } else {
-            self.sd() / (self.n as f64).sqrt()
+            self.sd(i) / (self.n as f64).sqrt()
         }
     }
 }
@@ -136,16 +151,16 @@ mod tests {
     }
 
     #[test]
-    fn shifted_sums_match_welford_with_a_large_mean() {
+    fn bin_stats_match_welford_with_a_large_mean() {
         let v: Vec<f64> = (0..1000).map(|i| 1e6 + (i as f64 * 0.7).sin()).collect();
-        let (mut a, mut b) = (RunningStats::default(), ShiftedSums::default());
+        let (mut a, mut b) = (RunningStats::default(), BinStats::new(2));
         v.iter().for_each(|&x| {
             a.push(x);
-            b.push(x)
+            b.push(&[x, 2.0 * x])
         });
-        assert!((a.mean() - b.mean()).abs() < 1e-9);
-        assert!((a.sd() - b.sd()).abs() < 1e-9 * a.sd());
-        assert!((a.se() - b.se()).abs() < 1e-9 * a.se());
+        assert!((a.mean() - b.mean(0)).abs() < 1e-9 && (2.0 * a.mean() - b.mean(1)).abs() < 1e-9);
+        assert!((a.sd() - b.sd(0)).abs() < 1e-9 * a.sd());
+        assert!((a.se() - b.se(0)).abs() < 1e-9 * a.se());
     }
 
     #[test]

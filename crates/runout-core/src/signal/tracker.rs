@@ -219,9 +219,9 @@ impl PhaseTracker {
                 last_phase,
                 fit,
             } => {
+                let dt = 1.0 / fs;
                 for i in 0..c.len() {
-                    let t = (start + i as u64) as f64 / fs;
-                    let rel = t - from;
+                    let rel = (start + i as u64) as f64 * dt - from;
                     if rel < 0.0 {
                         continue;
                     }
