@@ -15,9 +15,13 @@
 //! after θ_origin — an arbitrary reference tooth; the runout angle is then relative to it.
 //!
 //! **Per-tooth peak** (`conventions.md`, "Signals"): the maximum of the synchronously averaged
-//! chosen component within the tooth period (parabolic refinement over the neighbouring bins);
-//! its uncertainty is the revolution-to-revolution scatter: the per-revolution maxima in the
-//! same period give mean ± sd, and se = sd/√n.
+//! chosen component within the tooth period (parabolic refinement over the neighbouring bins).
+//! Its uncertainty is revolution-to-revolution scatter, taken as the larger of two standard
+//! errors: that of the revolutions' values at the peak's bin, and that of the per-revolution
+//! maxima in the period (sd/√n; alone it understates the scatter of the average's maximum on a
+//! flat top by ≈ 1.6× in the tests). The mean of the per-revolution maxima is reported too; noise
+//! lifts every per-revolution maximum, so it is biased upwards (≈ +0.6 σ of the sample noise in
+//! the tests) and is not the estimate.
 //!
 //! The air-cut offset found in pass 1 is subtracted first (`SignalConfig::subtract_air_offset`).
 //!
@@ -83,21 +87,28 @@ pub struct ToothPeakEstimate {
     /// Start of the tooth period θ (rad).
     #[serde(rename = "period_start_rad")]
     pub period_start: f64,
-    /// Maximum of the averaged component in the period (N).
+    /// The per-tooth peak (N): maximum of the synchronously averaged waveform in the period.
     #[serde(rename = "peak_N")]
     pub peak: f64,
-    /// Spindle angle θ of that maximum (rad, in [0, 2π)).
-    #[serde(rename = "angle_rad")]
-    pub angle: f64,
-    /// Mean of the per-revolution maxima (N; biased upwards by noise relative to `peak`).
-    #[serde(rename = "per_rev_mean_N")]
-    pub per_rev_mean: f64,
-    /// Revolution-to-revolution standard deviation of the per-revolution maxima (N).
-    #[serde(rename = "per_rev_sd_N")]
-    pub per_rev_sd: f64,
-    /// Standard error, per_rev_sd/√n (N): the uncertainty of `peak`.
+    /// Standard error of `peak` (N): the larger of the revolution-to-revolution standard error
+    /// at the peak's bin (sd of the revolutions' values there /√n) and that of the per-revolution
+    /// maxima (`per_rev_max_se`).
     #[serde(rename = "se_N")]
     pub se: f64,
+    /// Spindle angle θ of `peak` (rad, in [0, 2π)).
+    #[serde(rename = "angle_rad")]
+    pub angle: f64,
+    /// Mean over the revolutions of the per-revolution maxima in the period (N). Noise lifts each
+    /// maximum, so this exceeds `peak` by the noise-induced bias of a maximum (≈ 0.6 σ of the
+    /// sample noise in the tests); use it to gauge that bias, not as the peak.
+    #[serde(rename = "per_rev_max_mean_N")]
+    pub per_rev_max_mean: f64,
+    /// Revolution-to-revolution standard deviation of the per-revolution maxima (N).
+    #[serde(rename = "per_rev_max_sd_N")]
+    pub per_rev_max_sd: f64,
+    /// Standard error of `per_rev_max_mean`, sd/√n (N).
+    #[serde(rename = "per_rev_max_se_N")]
+    pub per_rev_max_se: f64,
 }
 
 /// Result of pass 3.
@@ -268,7 +279,7 @@ impl SyncAverager {
             } = self.marks
             {
                 // append up to and including the first sample after the next mark, in bulk
-                let te = (next <= last).then(|| t_ref + next as f64 * period);
+                let te = (next <= last).then_some(t_ref + next as f64 * period);
                 let ne = te.map_or(u64::MAX, |te| (te * self.fs).floor() as u64 + 1);
                 let seg_end = (ne.saturating_sub(start).saturating_add(1)).min(len as u64) as usize;
                 let seg_end = seg_end.max(i + 1);
@@ -343,7 +354,10 @@ impl SyncAverager {
             self.edges.clear();
             self.edges.push(te);
         }
-        // keep the samples from just before the revolution start
+        if self.edges.len() > 1 {
+            return; // inside a revolution (encoder): keep everything since its first edge
+        }
+        // a revolution starts here: keep the samples from just before it
         let keep = ((te * self.fs).floor() as u64)
             .saturating_sub(1)
             .max(self.buf_start);
@@ -421,18 +435,27 @@ impl SyncAverager {
             })
             .collect();
         let (b0, owner) = self.owner.clone().unwrap_or_default();
-        let wave = &components[self.component.index()].mean;
-        let tooth_peaks = period_peaks(wave, &owner, self.k)
+        let chosen = &components[self.component.index()];
+        let tooth_peaks = period_peaks(&chosen.mean, &owner, self.k)
             .into_iter()
             .enumerate()
-            .map(|(i, (jf, peak))| ToothPeakEstimate {
-                tooth: i,
-                period_start: wrap_tau(b0 + TAU * i as f64 / self.k as f64),
-                peak,
-                angle: wrap_tau(self.origin + TAU * jf / m as f64),
-                per_rev_mean: self.teeth[i].mean(),
-                per_rev_sd: self.teeth[i].sd(),
-                se: self.teeth[i].se(),
+            .map(|(i, (jf, peak))| {
+                let bin_se = if jf.is_finite() {
+                    let j = jf.floor() as usize % m;
+                    chosen.se[j].max(chosen.se[(j + 1) % m])
+                } else {
+                    f64::NAN
+                };
+                ToothPeakEstimate {
+                    tooth: i,
+                    period_start: wrap_tau(b0 + TAU * i as f64 / self.k as f64),
+                    peak,
+                    se: bin_se.max(self.teeth[i].se()),
+                    angle: wrap_tau(self.origin + TAU * jf / m as f64),
+                    per_rev_max_mean: self.teeth[i].mean(),
+                    per_rev_max_sd: self.teeth[i].sd(),
+                    per_rev_max_se: self.teeth[i].se(),
+                }
             })
             .collect();
         Ok(SyncAverage {

@@ -71,10 +71,13 @@ impl std::str::FromStr for Component {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PulseConfig {
     /// Rising edges per spindle revolution (1 for a once-per-rev mark, N for an N-line encoder).
-    /// With N > 1 the first edge of the section is taken as the revolution start.
+    /// With N > 1 the first edge of the section is taken as the revolution start, so the angle is
+    /// relative (an encoder's index channel is a once-per-rev mark: pass that for an absolute
+    /// angle); the angle between edges is interpolated piecewise linearly.
     pub pulses_per_rev: usize,
     /// Spindle angle θ (rad; tooth 0's tip at immersion θ, as in `ForceSeries::angle`) at the
-    /// rising edge that starts a revolution. `None`: the angle is relative to that edge.
+    /// rising edge (high-threshold crossing) of the once-per-rev mark. `None`: the angle is
+    /// relative to that edge. Only with `pulses_per_rev` = 1.
     pub tooth0_angle_rad: Option<f64>,
     /// Hysteresis thresholds (low, high) in the channel's unit; `None`: 30 % and 70 % of the
     /// channel's range, found in pass 1.
@@ -206,6 +209,14 @@ impl SignalConfig {
             }
             if let Some(a) = p.tooth0_angle_rad {
                 crate::error::finite("tooth0_angle_rad", a)?;
+                if p.pulses_per_rev != 1 {
+                    return Err(ParamError::new(
+                        "tooth0_angle_rad",
+                        "no tooth-0 angle with an N-line encoder (pulses_per_rev > 1): give its index channel as a once-per-rev pulse",
+                        a,
+                    )
+                    .into());
+                }
             }
         }
         if let Some(a) = self.entry_angle_rad {

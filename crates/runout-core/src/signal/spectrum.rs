@@ -41,7 +41,7 @@ pub(crate) struct Welch {
 /// 64·(1 + ln(N/64)) of N frames cost an FFT (the spectrum only has to locate the line; the
 /// phase tracker refines the frequency). Deterministic, hence independent of chunking.
 fn transformed(i: usize) -> bool {
-    i < 64 || i % (i / 64 + 1) == 0
+    i < 64 || i.checked_rem(i / 64 + 1) == Some(0)
 }
 
 /// Hann window of length `len` (periodic-symmetric at sample centres).
