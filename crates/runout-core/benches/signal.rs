@@ -63,7 +63,7 @@ fn buffers() -> Buffers {
 fn replay<'b>(b: &'b Buffers) -> impl FnMut(&mut ChunkSink<'_>) -> Result<(), SignalError> + 'b {
     move |sink| {
         for i in 0..CHUNKS {
-            let v = if i < 2 || i >= CHUNKS - 2 {
+            let v = if !(2..CHUNKS - 2).contains(&i) {
                 &b.air
             } else {
                 &b.cut
