@@ -570,6 +570,29 @@ fn phm2010_slice_speed_and_three_tooth_peaks() {
         let d = wrap_pi(p[(i + 1) % 3].angle - p[i].angle - TAU / 3.0).abs();
         assert!(d < 10f64.to_radians(), "{p:?}");
     }
+    // JSON: units in the field names
+    let json = serde_json::to_value(&a).unwrap();
+    assert!(json["speed"]["rpm_se"].as_f64().unwrap() > 0.0);
+    assert!(
+        json["scan"]["tooth_passing"]["frequency_hz"]
+            .as_f64()
+            .unwrap()
+            > 500.0
+    );
+    assert_eq!(json["average"]["peak_component"], "fxy");
+    assert!(
+        json["average"]["tooth_peaks"][0]["peak_N"]
+            .as_f64()
+            .unwrap()
+            > 29.0
+    );
+    assert_eq!(
+        json["average"]["components"][3]["mean_N"]
+            .as_array()
+            .unwrap()
+            .len(),
+        a.average.bins
+    );
     // streaming gives the same result
     let streamed = analyse_chunked(&phm_config(), Chunk::xyz(&fx, &fy, &fz), 100).unwrap();
     assert_eq!(format!("{streamed:?}"), format!("{a:?}"));

@@ -66,8 +66,9 @@ pub use stats::RunningStats;
 pub use steady::{SteadySection, MAX_BLOCKS};
 pub use tracker::{PhaseTracker, SpeedMethod, SpindleSpeed};
 
-/// Everything the pipeline found.
-#[derive(Debug, Clone, PartialEq)]
+/// Everything the pipeline found (serialisable; angles in rad, forces in N, times in s: the CLI
+/// converts angles to degrees).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SignalAnalysis {
     /// Pass 1: spectrum line, section, recording length.
     pub scan: ScanResult,

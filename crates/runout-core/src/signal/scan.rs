@@ -19,7 +19,7 @@ pub struct SpindleScan {
 }
 
 /// What pass 1 found.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ScanResult {
     /// Samples in the recording.
     pub samples: u64,
@@ -31,7 +31,8 @@ pub struct ScanResult {
     pub coarse_spindle_hz: f64,
     /// The section to average (detected, or the override).
     pub section: SteadySection,
-    /// Pulse thresholds (low, high) to use in passes 2 and 3.
+    /// Pulse thresholds (low, high) to use in passes 2 and 3, in the pulse channel's unit.
+    #[serde(rename = "pulse_thresholds_low_high")]
     pub pulse_thresholds: Option<(f64, f64)>,
     /// F_z present in the chunks.
     pub has_fz: bool,

@@ -52,9 +52,10 @@ fn hann(len: usize) -> Vec<f64> {
 }
 
 /// The tooth-passing line found in the spectrum.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct ToothPassingLine {
     /// Refined frequency (Hz).
+    #[serde(rename = "frequency_hz")]
     pub hz: f64,
     /// Power of the line relative to the strongest line above half the nominal spindle frequency.
     pub relative_power: f64,
@@ -69,6 +70,7 @@ pub struct ToothPassingLine {
     /// relative to the line). Above 0.1 (−10 dB) suggests fewer teeth than stated (K/d teeth put
     /// their tooth-passing line on harmonic K/d), or a large runout (runout side-bands are typically
     /// 15–25 dB weaker).
+    #[serde(rename = "strongest_below_hz_and_relative_power")]
     pub strongest_below: (f64, f64),
 }
 

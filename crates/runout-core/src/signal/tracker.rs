@@ -57,8 +57,10 @@ pub struct SpindleSpeed {
     pub coarse_rpm: f64,
     /// Regression points (blocks or edges).
     pub points: usize,
-    /// Residual RMS of the regression (rad for phase tracking, s for pulse edges).
+    /// Residual RMS of the regression, in `residual_unit`.
     pub residual_rms: f64,
+    /// Unit of `residual_rms`: "rad" (phase tracking) or "s" (pulse edge times).
+    pub residual_unit: &'static str,
     /// Revolution-to-revolution relative scatter of the period (pulse method only).
     pub speed_variation: Option<f64>,
 }
@@ -365,6 +367,11 @@ impl PhaseTracker {
             coarse_rpm,
             points,
             residual_rms: rms,
+            residual_unit: if method == SpeedMethod::Pulse {
+                "s"
+            } else {
+                "rad"
+            },
             speed_variation: var,
         })
     }
