@@ -373,6 +373,22 @@ fn synthetic_round_trip_with_once_per_rev_pulse_is_absolute() {
     check_average(&syn, &a.average, 0.0, 0.0);
     check_peaks(&syn, &a.average, 0.0, 0);
     assert!(!a.warnings.iter().any(|w| w.contains("arbitrary")));
+    assert!(a.warnings.is_empty(), "{:?}", a.warnings);
+    // a wrong pulses_per_rev: 2 instead of 1 → half the speed, contradicted by the spectrum
+    let mut wrong = cfg.clone();
+    if let Some(p) = wrong.pulse.as_mut() {
+        p.pulses_per_rev = 2;
+        p.tooth0_angle_rad = None;
+    }
+    let w = analyse(&wrong, syn.chunk_with_pulse()).unwrap();
+    assert!((w.speed.rpm - 3030.0).abs() < 1.0, "{:?}", w.speed);
+    assert!(
+        w.warnings
+            .iter()
+            .any(|m| m.contains("check pulses_per_rev (2)")),
+        "{:?}",
+        w.warnings
+    );
 }
 
 #[test]

@@ -248,7 +248,11 @@ impl SyncAverager {
             buf: Vec::new(),
             buf_start: 0,
             edges: Vec::with_capacity(per_rev + 1),
-            max_buf: (4.0 * period.max(60.0 / cfg.nominal_rpm) * fs) as usize + 16,
+            // 4 nominal revolutions (the pulse path errors out beyond; the linear path holds one)
+            max_buf: (4.0
+                * (60.0 / cfg.nominal_rpm).max(period.min(1.5 * 60.0 / cfg.nominal_rpm))
+                * fs) as usize
+                + 16,
             acc: BinStats::new(4 * m),
             scratch: vec![0.0; 4 * m],
             owner: None,

@@ -107,6 +107,15 @@ where
             scan.tooth_passing.resolution_hz
         ));
     }
+    if speed.method == SpeedMethod::Pulse && (speed.rpm / speed.coarse_rpm - 1.0).abs() > 0.01 {
+        warnings.push(format!(
+            "the pulse channel gives {:.1} rpm but the tooth-passing line {:.1} rpm: check pulses_per_rev ({}) and teeth ({})",
+            speed.rpm,
+            speed.coarse_rpm,
+            cfg.pulse.map_or(0, |p| p.pulses_per_rev),
+            cfg.teeth
+        ));
+    }
     let (below_hz, below_rel) = scan.tooth_passing.strongest_below;
     if below_rel > 0.1 {
         warnings.push(format!(
