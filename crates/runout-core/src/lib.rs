@@ -27,6 +27,7 @@ pub mod error;
 pub mod force;
 pub mod grind;
 pub mod runout;
+pub mod signal;
 
 pub use chip::{ArcChip, ChipAtHeight, ChipThickness};
 pub use coefficients::CuttingCoefficients;
