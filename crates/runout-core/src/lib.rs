@@ -25,6 +25,7 @@ pub mod cut;
 pub mod cutter;
 pub mod error;
 pub mod force;
+pub mod identify;
 pub mod runout;
 
 pub use chip::{ArcChip, ChipAtHeight, ChipThickness};

@@ -1,0 +1,27 @@
+//! Identification of runout (and cutting coefficients) from measured forces, methods.md §4.
+//!
+//! All functions take in-memory data (per-tooth peak tables, mean forces, synchronously averaged
+//! waveforms); reading recordings is `runout-io`'s job. Conventions: `conventions.md` (teeth in
+//! cutting order, runout e = ρ(cos λ, sin λ) from tooth 0 in the rotation direction, forces on the
+//! workpiece). Angles in rad, lengths in mm.
+//!
+//! * [`sine_fit`] — seed 003 per-tooth peak sine fit (eq. 10–12) with standard errors.
+//! * [`analyse_tests`] — several tests: regressions, K_T/K_R (seed eq. 17), pooled
+//!   edge-force-aware fit ([`pooled_fit`], §4.6).
+
+mod error;
+mod lsq;
+mod multi_test;
+mod peak_coefficients;
+mod pooled;
+mod sine_fit;
+
+pub use error::IdentifyError;
+pub use lsq::{fit_line, linear_lsq, r_squared, LinearFit, Regression};
+pub use multi_test::{analyse_tests, MultiTestResult, PeakTest, TestResult};
+pub use peak_coefficients::{coefficients_at_peak, PeakCoefficients};
+pub use pooled::{pooled_fit, EdgeModel, PooledFit};
+pub use sine_fit::{
+    peak_immersion, sine_fit, ErrorSource, Estimate, PeakConditions, SineFit, SineHypothesis,
+    ToothPeaks,
+};
