@@ -8,13 +8,20 @@
 //! * [`sine_fit`] — seed 003 per-tooth peak sine fit (eq. 10–12) with standard errors.
 //! * [`analyse_tests`] — several tests: regressions, K_T/K_R (seed eq. 17), pooled
 //!   edge-force-aware fit ([`pooled_fit`], §4.6).
+//! * [`frequency_estimate`] — spindle-harmonic runout estimate (§4.7), a fast start value.
+//! * [`full_signal_fit`] — non-linear least squares of averaged waveforms (runout vector, tilt,
+//!   six coefficients), several recordings jointly; works for K = 2.
 
 mod error;
+mod frequency;
+mod full_signal;
 mod lsq;
+mod model;
 mod multi_test;
 mod peak_coefficients;
 mod pooled;
 mod sine_fit;
+mod waveform;
 
 pub use error::IdentifyError;
 pub use lsq::{fit_line, linear_lsq, r_squared, LinearFit, Regression};
@@ -25,3 +32,7 @@ pub use sine_fit::{
     peak_immersion, sine_fit, ErrorSource, Estimate, PeakConditions, SineFit, SineHypothesis,
     ToothPeaks,
 };
+pub use frequency::{frequency_estimate, FrequencyEstimate};
+pub use full_signal::{full_signal_fit, FullSignalFit, FullSignalOptions};
+pub use model::{coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel};
+pub use waveform::{AveragedWaveform, Axis, Component, WaveformCase};
