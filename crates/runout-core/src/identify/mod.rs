@@ -33,6 +33,6 @@ pub use sine_fit::{
     ToothPeaks,
 };
 pub use frequency::{frequency_estimate, FrequencyEstimate};
-pub use full_signal::{full_signal_fit, FullSignalFit, FullSignalOptions};
+pub use full_signal::{full_signal_fit, FullSignalFit, FullSignalOptions, RunoutObservability};
 pub use model::{coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel};
 pub use waveform::{AveragedWaveform, Axis, Component, WaveformCase};
