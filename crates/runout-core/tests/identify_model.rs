@@ -39,31 +39,50 @@ fn compare(cutter: Cutter, runout: Runout, cut: Cut, disks: usize) {
 fn revolution_model_matches_simulation() {
     let c4 = Cutter::flat(10.0, 4, 30.0).unwrap();
     let r = Runout::new(0.012, 0.7).unwrap();
-    let up = Cut::new(3000.0, 0.08, 2.0).unwrap().radial(2.0, MillingMode::Up, &c4).unwrap();
+    let up = Cut::new(3000.0, 0.08, 2.0)
+        .unwrap()
+        .radial(2.0, MillingMode::Up, &c4)
+        .unwrap();
     compare(c4.clone(), r, up, 20);
-    let down = Cut::new(3000.0, 0.1, 1.5).unwrap().radial(3.0, MillingMode::Down, &c4).unwrap();
+    let down = Cut::new(3000.0, 0.1, 1.5)
+        .unwrap()
+        .radial(3.0, MillingMode::Down, &c4)
+        .unwrap();
     compare(c4.clone(), r.with_tilt(0.004, 2.0).unwrap(), down, 12);
     // variable pitch, 3 teeth, edge skipping runout (2ρ sin(π/3) > f_z)
     let c3 = Cutter::new(
         8.0,
-        vec![110f64.to_radians(), 120f64.to_radians(), 130f64.to_radians()],
+        vec![
+            110f64.to_radians(),
+            120f64.to_radians(),
+            130f64.to_radians(),
+        ],
         0.0,
         f64::INFINITY,
         RadiusProfile::Flat,
     )
     .unwrap();
     let big = Runout::new(0.05, -1.2).unwrap();
-    let slot = Cut::new(3000.0, 0.04, 1.0).unwrap().angles(0.3, 2.9).unwrap();
+    let slot = Cut::new(3000.0, 0.04, 1.0)
+        .unwrap()
+        .angles(0.3, 2.9)
+        .unwrap();
     compare(c3, big, slot, 1);
     let c2 = Cutter::flat(6.0, 2, 0.0).unwrap();
-    let cut2 = Cut::new(3000.0, 0.05, 1.0).unwrap().radial(1.0, MillingMode::Up, &c2).unwrap();
+    let cut2 = Cut::new(3000.0, 0.05, 1.0)
+        .unwrap()
+        .radial(1.0, MillingMode::Up, &c2)
+        .unwrap();
     compare(c2, Runout::new(0.008, 2.5).unwrap(), cut2, 1);
 }
 
 #[test]
 fn runout_derivatives_match_finite_differences() {
     let c = Cutter::flat(10.0, 4, 30.0).unwrap();
-    let cut = Cut::new(3000.0, 0.08, 2.0).unwrap().radial(4.0, MillingMode::Down, &c).unwrap();
+    let cut = Cut::new(3000.0, 0.08, 2.0)
+        .unwrap()
+        .radial(4.0, MillingMode::Down, &c)
+        .unwrap();
     let m = RevolutionModel::new(&c, &cut, 0.013, 360, 10);
     let e = [0.006, -0.004];
     let tau = [0.001, 0.002];
@@ -140,17 +159,44 @@ impl ChipAtHeight for LinearAt {
 fn frequency_estimate_exact_on_linear_chip_model() {
     // methods.md §7: linear chip model, ρ 8 µm, α₀ −50° → exactly 8.00 µm, −50.00°
     // (and 12 µm / 100°). Engagement 30°..150° keeps h > 0 so the simulation is the linear model.
-    for (k, helix, rho, lam) in [(4, 0.0, 0.008, -50.0), (4, 30.0, 0.012, 100.0), (2, 30.0, 0.008, 40.0), (3, 30.0, 0.005, -150.0)] {
+    for (k, helix, rho, lam) in [
+        (4, 0.0, 0.008, -50.0),
+        (4, 30.0, 0.012, 100.0),
+        (2, 30.0, 0.008, 40.0),
+        (3, 30.0, 0.005, -150.0),
+    ] {
         let c = Cutter::flat(10.0, k, helix).unwrap();
         let r = Runout::new(rho, f64::to_radians(lam)).unwrap();
-        let cut = Cut::new(3240.0, 0.1, 1.0).unwrap().angles(0.5236, 2.618).unwrap();
+        let cut = Cut::new(3240.0, 0.1, 1.0)
+            .unwrap()
+            .angles(30f64.to_radians(), 150f64.to_radians())
+            .unwrap();
         let kc = coeffs().without_edge();
-        let model = ForceModel { cutter: c.clone(), runout: r, cut, coefficients: kc };
-        let chip = LinearChip { cutter: c.clone(), runout: r, fz: 0.1 };
+        let model = ForceModel {
+            cutter: c.clone(),
+            runout: r,
+            cut,
+            coefficients: kc,
+        };
+        let chip = LinearChip {
+            cutter: c.clone(),
+            runout: r,
+            fz: 0.1,
+        };
         let disks = if helix > 0.0 { 16 } else { 1 };
         let s = model.simulate(&chip, &Sampling::new(1.0, 0.5, disks).unwrap());
-        let w = AveragedWaveform::average(0.0, s.len(), &[(Axis::X, &s.fx), (Axis::Y, &s.fy)]).unwrap();
-        let est = frequency_estimate(&[WaveformCase { cutter: c, cut, waveform: w }], &kc, disks).unwrap();
+        let w =
+            AveragedWaveform::average(0.0, s.len(), &[(Axis::X, &s.fx), (Axis::Y, &s.fy)]).unwrap();
+        let est = frequency_estimate(
+            &[WaveformCase {
+                cutter: c,
+                cut,
+                waveform: w,
+            }],
+            &kc,
+            disks,
+        )
+        .unwrap();
         // exact up to rounding (1e-6 µm, 1e-6°)
         assert!((est.offset - rho).abs() < 1e-9, "{k} {est:?}");
         assert!((est.angle.to_degrees() - lam).abs() < 1e-6, "{k} {est:?}");
@@ -158,12 +204,27 @@ fn frequency_estimate_exact_on_linear_chip_model() {
     // K = 2 with straight flutes: the offset across the tooth line changes neither radius to
     // first order — unobservable; the estimate must refuse rather than guess.
     let c = Cutter::flat(10.0, 2, 0.0).unwrap();
-    let cut = Cut::new(3240.0, 0.1, 1.0).unwrap().angles(0.5236, 2.618).unwrap();
+    let cut = Cut::new(3240.0, 0.1, 1.0)
+        .unwrap()
+        .angles(30f64.to_radians(), 150f64.to_radians())
+        .unwrap();
     let n = 720;
     let model = RevolutionModel::new(&c, &cut, 0.0, n, 1);
     let s = model.sums([0.004, 0.003], [0.0, 0.0], false);
-    let fx: Vec<f64> = s.base.iter().map(|b| force_from_basis(Axis::X, b, &coeffs())).collect();
+    let fx: Vec<f64> = s
+        .base
+        .iter()
+        .map(|b| force_from_basis(Axis::X, b, &coeffs()))
+        .collect();
     let w = AveragedWaveform::average(0.0, n, &[(Axis::X, &fx)]).unwrap();
-    let e = frequency_estimate(&[WaveformCase { cutter: c, cut, waveform: w }], &coeffs(), 1);
+    let e = frequency_estimate(
+        &[WaveformCase {
+            cutter: c,
+            cut,
+            waveform: w,
+        }],
+        &coeffs(),
+        1,
+    );
     assert!(matches!(e, Err(IdentifyError::Singular { .. })), "{e:?}");
 }

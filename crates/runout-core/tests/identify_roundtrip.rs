@@ -32,14 +32,24 @@ struct Setup {
 
 /// Simulate 20 revolutions at 1° steps, add white noise of σ = 2 % of each component's peak |F|
 /// to that component, and average synchronously (with the per-sample standard errors).
-fn recording(s: &Setup, fz: f64, kc: CuttingCoefficients, seed: u64) -> (WaveformCase, ForceSeries) {
+fn recording(
+    s: &Setup,
+    fz: f64,
+    kc: CuttingCoefficients,
+    seed: u64,
+) -> (WaveformCase, ForceSeries) {
     let cutter = Cutter::flat(10.0, s.teeth, s.helix_deg).unwrap();
     let runout = Runout::new(s.rho_um * 1e-3, s.lambda_deg.to_radians()).unwrap();
     let cut = Cut::new(3000.0, fz, s.ap_mm)
         .unwrap()
         .radial(s.ae_mm, s.mode, &cutter)
         .unwrap();
-    let model = ForceModel { cutter: cutter.clone(), runout, cut, coefficients: kc };
+    let model = ForceModel {
+        cutter: cutter.clone(),
+        runout,
+        cut,
+        coefficients: kc,
+    };
     let chip = ArcChip::new(&cutter, &runout, fz).unwrap();
     // the "truth" uses finer disks (helix lag 0.05° per disk) than the identification model's
     // automatic choice (0.1°)
@@ -53,9 +63,18 @@ fn recording(s: &Setup, fz: f64, kc: CuttingCoefficients, seed: u64) -> (Wavefor
         v.iter().map(|x| x + noise.sample(&mut rng)).collect()
     };
     let (fx, fy, fz_) = (noisy(&series.fx), noisy(&series.fy), noisy(&series.fz));
-    let waveform = AveragedWaveform::average(0.0, 360, &[(Axis::X, &fx), (Axis::Y, &fy), (Axis::Z, &fz_)]).unwrap();
+    let waveform =
+        AveragedWaveform::average(0.0, 360, &[(Axis::X, &fx), (Axis::Y, &fy), (Axis::Z, &fz_)])
+            .unwrap();
     assert_eq!(waveform.revolutions, 20);
-    (WaveformCase { cutter, cut, waveform }, series)
+    (
+        WaveformCase {
+            cutter,
+            cut,
+            waveform,
+        },
+        series,
+    )
 }
 
 fn kc() -> CuttingCoefficients {
@@ -74,22 +93,41 @@ fn check(s: &Setup, feeds: &[f64], seed: u64) -> FullSignalFit {
         .map(|(j, &f)| recording(s, f, kc(), seed + j as u64).0)
         .collect();
     let fit = full_signal_fit(&cases, &FullSignalOptions::default()).unwrap();
-    let msg = format!("{s:?}: ρ {:.3} µm λ {:.2}° coeff {:?} ± {:?} cond {:.2e} {:?}", fit.offset.value * 1e3,
-        fit.angle.value.to_degrees(), fit.coefficients, fit.coefficient_se, fit.condition, fit.warnings);
+    let msg = format!(
+        "{s:?}: ρ {:.3} µm λ {:.2}° coeff {:?} ± {:?} cond {:.2e} {:?}",
+        fit.offset.value * 1e3,
+        fit.angle.value.to_degrees(),
+        fit.coefficients,
+        fit.coefficient_se,
+        fit.condition,
+        fit.warnings
+    );
     assert_eq!(fit.observability, RunoutObservability::Full, "{msg}");
     assert!((fit.offset.value * 1e3 - s.rho_um).abs() <= 0.3, "{msg}");
     let tol_deg = if s.rho_um >= 5.0 { 3.0 } else { 8.0 };
-    assert!(angle_diff_deg(fit.angle.value.to_degrees(), s.lambda_deg) <= tol_deg, "{msg}");
+    assert!(
+        angle_diff_deg(fit.angle.value.to_degrees(), s.lambda_deg) <= tol_deg,
+        "{msg}"
+    );
     let truth = kc().to_array();
-    for i in 0..5 {
+    for (i, t) in truth.iter().enumerate().take(5) {
         // K_ae = −3.1 N/mm is tiny; its 2 % (0.06 N/mm) is below what 2 % noise resolves — it is
         // checked against its standard error instead (|error| < 4 SE).
-        assert!((fit.coefficients[i] / truth[i] - 1.0).abs() <= 0.02, "coef {i}: {msg}");
+        assert!(
+            (fit.coefficients[i] / t - 1.0).abs() <= 0.02,
+            "coef {i}: {msg}"
+        );
     }
     let se_kae = fit.coefficient_se[5].unwrap();
-    assert!((fit.coefficients[5] - truth[5]).abs() <= 4.0 * se_kae + 0.05, "kae: {msg}");
+    assert!(
+        (fit.coefficients[5] - truth[5]).abs() <= 4.0 * se_kae + 0.05,
+        "kae: {msg}"
+    );
     // the reported standard errors are plausible: the offset error within 5 SE (+ 0.05 µm model)
-    assert!((fit.offset.value * 1e3 - s.rho_um).abs() <= 5.0 * fit.offset.se.unwrap() * 1e3 + 0.05, "{msg}");
+    assert!(
+        (fit.offset.value * 1e3 - s.rho_um).abs() <= 5.0 * fit.offset.se.unwrap() * 1e3 + 0.05,
+        "{msg}"
+    );
     assert!(fit.r_squared > 0.98 && !fit.ill_conditioned, "{msg}");
     fit
 }
@@ -98,14 +136,69 @@ fn check(s: &Setup, feeds: &[f64], seed: u64) -> FullSignalFit {
 fn round_trip_representative_cases() {
     use MillingMode::*;
     let cases = [
-        (Setup { teeth: 4, helix_deg: 30.0, mode: Down, ae_mm: 2.0, ap_mm: 2.0, rho_um: 8.0, lambda_deg: 30.0 }, vec![0.08]),
-        (Setup { teeth: 3, helix_deg: 0.0, mode: Up, ae_mm: 3.0, ap_mm: 1.5, rho_um: 3.0, lambda_deg: -120.0 }, vec![0.06]),
-        (Setup { teeth: 6, helix_deg: 30.0, mode: Down, ae_mm: 4.0, ap_mm: 1.0, rho_um: 30.0, lambda_deg: 150.0 }, vec![0.05]),
+        (
+            Setup {
+                teeth: 4,
+                helix_deg: 30.0,
+                mode: Down,
+                ae_mm: 2.0,
+                ap_mm: 2.0,
+                rho_um: 8.0,
+                lambda_deg: 30.0,
+            },
+            vec![0.08],
+        ),
+        (
+            Setup {
+                teeth: 3,
+                helix_deg: 0.0,
+                mode: Up,
+                ae_mm: 3.0,
+                ap_mm: 1.5,
+                rho_um: 3.0,
+                lambda_deg: -120.0,
+            },
+            vec![0.06],
+        ),
+        (
+            Setup {
+                teeth: 6,
+                helix_deg: 30.0,
+                mode: Down,
+                ae_mm: 4.0,
+                ap_mm: 1.0,
+                rho_um: 30.0,
+                lambda_deg: 150.0,
+            },
+            vec![0.05],
+        ),
         // K = 2: the offset across the tooth line is seen only through the helix lag
         // a_p·tanβ/R (here 53°); at a_p = 3 mm (20° lag) the SE of ρ is 0.45 µm with this noise,
         // at 8 mm 0.07 µm — the reported SE says which (see two_teeth_* below).
-        (Setup { teeth: 2, helix_deg: 30.0, mode: Up, ae_mm: 3.0, ap_mm: 8.0, rho_um: 5.0, lambda_deg: 70.0 }, vec![0.08]),
-        (Setup { teeth: 4, helix_deg: 0.0, mode: Up, ae_mm: 2.0, ap_mm: 1.0, rho_um: 20.0, lambda_deg: -60.0 }, vec![0.06, 0.12]),
+        (
+            Setup {
+                teeth: 2,
+                helix_deg: 30.0,
+                mode: Up,
+                ae_mm: 3.0,
+                ap_mm: 8.0,
+                rho_um: 5.0,
+                lambda_deg: 70.0,
+            },
+            vec![0.08],
+        ),
+        (
+            Setup {
+                teeth: 4,
+                helix_deg: 0.0,
+                mode: Up,
+                ae_mm: 2.0,
+                ap_mm: 1.0,
+                rho_um: 20.0,
+                lambda_deg: -60.0,
+            },
+            vec![0.06, 0.12],
+        ),
     ];
     for (j, (s, feeds)) in cases.iter().enumerate() {
         let fit = check(s, feeds, 100 * j as u64);
@@ -121,7 +214,15 @@ fn round_trip_representative_cases() {
 #[test]
 fn two_teeth_straight_flutes_report_partial_observability() {
     // K = 2, straight flutes: only ρ·cos(λ − ψ₀) (along the tooth line) is observable.
-    let s = Setup { teeth: 2, helix_deg: 0.0, mode: MillingMode::Down, ae_mm: 3.0, ap_mm: 1.0, rho_um: 10.0, lambda_deg: 50.0 };
+    let s = Setup {
+        teeth: 2,
+        helix_deg: 0.0,
+        mode: MillingMode::Down,
+        ae_mm: 3.0,
+        ap_mm: 1.0,
+        rho_um: 10.0,
+        lambda_deg: 50.0,
+    };
     let (case, _) = recording(&s, 0.08, kc(), 7);
     let fit = full_signal_fit(&[case], &FullSignalOptions::default()).unwrap();
     match fit.observability {
@@ -129,15 +230,16 @@ fn two_teeth_straight_flutes_report_partial_observability() {
             assert!(direction[0].abs() > 0.999, "{direction:?}"); // the tooth line is the x axis
             let along = fit.vector[0].value * 1e3;
             // ρ cos λ = 6.43 µm; the second-order (ρ²/R) coupling and noise allow 0.3 µm
-            assert!((along - 10.0 * 50f64.to_radians().cos()).abs() < 0.3, "{along} {fit:?}");
+            assert!(
+                (along - 10.0 * 50f64.to_radians().cos()).abs() < 0.3,
+                "{along} {fit:?}"
+            );
         }
         other => panic!("expected partial observability, got {other:?}"),
     }
     assert!(fit.angle.se.is_none());
     assert!(fit.warnings.iter().any(|w| w.contains("partly observable")));
 }
-
-
 
 fn any_setup() -> impl Strategy<Value = Setup> {
     (
@@ -154,7 +256,11 @@ fn any_setup() -> impl Strategy<Value = Setup> {
             Setup {
                 teeth,
                 helix_deg,
-                mode: if up { MillingMode::Up } else { MillingMode::Down },
+                mode: if up {
+                    MillingMode::Up
+                } else {
+                    MillingMode::Down
+                },
                 ae_mm,
                 ap_mm: if teeth == 2 { 8.0 } else { 1.5 },
                 rho_um,
@@ -187,7 +293,15 @@ fn waveform_peaks(case: &WaveformCase) -> ToothPeaks {
 fn sine_fit_bias_on_simulated_data() {
     // Seed 003's set-up: K = 4, D 10, up-milling a_e 2 mm, a_p 1 mm, f_z 0.08, ρ 8 µm, λ −50°;
     // peaks of |F_xy| of the averaged noisy waveform, sine fit H0, γ = β = 53.13°.
-    let base = Setup { teeth: 4, helix_deg: 0.0, mode: MillingMode::Up, ae_mm: 2.0, ap_mm: 1.0, rho_um: 8.0, lambda_deg: -50.0 };
+    let base = Setup {
+        teeth: 4,
+        helix_deg: 0.0,
+        mode: MillingMode::Up,
+        ae_mm: 2.0,
+        ap_mm: 1.0,
+        rho_um: 8.0,
+        lambda_deg: -50.0,
+    };
     let shear_only = kc().without_edge();
     let run = |s: Setup, k: CuttingCoefficients| {
         let (case, _) = recording(&s, 0.08, k, 11);
@@ -196,9 +310,16 @@ fn sine_fit_bias_on_simulated_data() {
         let full = full_signal_fit(&[case], &FullSignalOptions::default()).unwrap();
         let bias = f.offset.value * 1e3 / s.rho_um - 1.0;
         let dl = angle_diff_deg(f.angle.value.to_degrees(), s.lambda_deg);
-        println!("helix {} edge {}: sine ρ {:.3} µm ({:+.1} %), λ {:.2}° | full ρ {:.3} µm λ {:.2}°",
-            s.helix_deg, k.kte != 0.0, f.offset.value * 1e3, bias * 100.0, f.angle.value.to_degrees(),
-            full.offset.value * 1e3, full.angle.value.to_degrees());
+        println!(
+            "helix {} edge {}: sine ρ {:.3} µm ({:+.1} %), λ {:.2}° | full ρ {:.3} µm λ {:.2}°",
+            s.helix_deg,
+            k.kte != 0.0,
+            f.offset.value * 1e3,
+            bias * 100.0,
+            f.angle.value.to_degrees(),
+            full.offset.value * 1e3,
+            full.angle.value.to_degrees()
+        );
         // the full-signal method stays within the tolerance in every scenario
         assert!((full.offset.value * 1e3 - s.rho_um).abs() <= 0.3);
         (bias, dl)
@@ -207,10 +328,18 @@ fn sine_fit_bias_on_simulated_data() {
     let (b, dl) = run(base, shear_only);
     assert!(b.abs() < BIAS_STRAIGHT && dl < 3.0, "{b} {dl}");
     // (b) 30° helix: the axial slices do not peak together; C shrinks more than A → ρ biased high
-    let (b, dl) = run(Setup { helix_deg: 30.0, ..base }, shear_only);
-    assert!((BIAS_HELIX.0..BIAS_HELIX.1).contains(&b) && dl < 4.0, "{b} {dl}");
+    let (b, dl) = run(
+        Setup {
+            helix_deg: 30.0,
+            ..base
+        },
+        shear_only,
+    );
+    assert!(
+        (BIAS_HELIX.0..BIAS_HELIX.1).contains(&b) && dl < 4.0,
+        "{b} {dl}"
+    );
     // (c) edge forces (K_te 63, K_re 114 N/mm): they inflate C, not A → ρ biased low
     let (b, dl) = run(base, kc());
     assert!((BIAS_EDGE.0..BIAS_EDGE.1).contains(&b), "{b} {dl}");
 }
-

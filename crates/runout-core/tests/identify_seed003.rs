@@ -60,7 +60,10 @@ fn table2_reproduced_under_closed_period_hypothesis() {
         assert!((fit.mean.value - c).abs() <= 0.5, "{msg}");
         assert!((fit.amplitude.value - a).abs() <= 1.0, "{msg}");
         assert!((fit.phase.value.to_degrees() - phi).abs() <= 0.5, "{msg}");
-        assert!((fit.angle.value.to_degrees() - alpha0).abs() <= 0.5, "{msg}");
+        assert!(
+            (fit.angle.value.to_degrees() - alpha0).abs() <= 0.5,
+            "{msg}"
+        );
         assert!((fit.offset.value - rho).abs() <= 0.3e-3, "{msg}");
         assert!((fit.r_squared - r2).abs() <= 0.01, "{msg}");
         // H1 reproduces the printed rounding much more tightly (methods.md §4.3: ≤ 0.08 N, 0.08°).
@@ -116,15 +119,25 @@ fn secondary_regressions_and_cutting_coefficients() {
     let c: Vec<f64> = depth.iter().map(|t| t.fit.mean.value).collect();
     let fa: Vec<f64> = depth.iter().map(|t| t.fz_mm * t.ap_mm).collect();
     let a1 = fit_line(&ap, &amp, true).unwrap();
-    assert!((a1.slope - 59.8).abs() < 0.1 && (a1.intercept + 1.1).abs() < 0.1, "{a1:?}");
+    assert!(
+        (a1.slope - 59.8).abs() < 0.1 && (a1.intercept + 1.1).abs() < 0.1,
+        "{a1:?}"
+    );
     assert!((a1.r_squared - 0.993).abs() < 0.001, "{a1:?}");
     let a0 = fit_line(&ap, &amp, false).unwrap();
     assert!((a0.slope - 58.7).abs() < 0.1, "{a0:?}");
     let c1 = fit_line(&fa, &c, true).unwrap();
-    assert!((c1.slope - 3523.2).abs() < 3.5 && (c1.intercept - 32.6).abs() < 0.3, "{c1:?}");
+    assert!(
+        (c1.slope - 3523.2).abs() < 3.5 && (c1.intercept - 32.6).abs() < 0.3,
+        "{c1:?}"
+    );
     assert!((c1.r_squared - 0.997).abs() < 0.001, "{c1:?}");
     // mean A over tests 1–4: 50.6 (paper 50.7)
-    let mean_a: f64 = r.tests[..4].iter().map(|t| t.fit.amplitude.value).sum::<f64>() / 4.0;
+    let mean_a: f64 = r.tests[..4]
+        .iter()
+        .map(|t| t.fit.amplitude.value)
+        .sum::<f64>()
+        / 4.0;
     assert!((mean_a - 50.6).abs() < 0.05);
     // means: α₀ −49.59° (arithmetic), ρ 8.14 µm; vector mean 7.91 µm at −50.0° (methods.md §4.3)
     assert!((r.arithmetic_mean.1.to_degrees() + 49.59).abs() < 0.05); // fitted: −49.57
@@ -143,9 +156,24 @@ fn pooled_edge_aware_fit_matches_section_4_6() {
     let edge = pooled_fit(&t, EdgeModel::ConstantPlusDepth).unwrap();
     let um = |e: &Estimate| (e.value * 1e3, e.se.unwrap() * 1e3);
     let deg = |e: &Estimate| (e.value.to_degrees(), e.se.unwrap().to_degrees());
-    println!("none {:?} {:?} {}", um(&none.offset), deg(&none.angle), none.residual_rms);
-    println!("cst {:?} {:?} {}", um(&cst.offset), deg(&cst.angle), cst.residual_rms);
-    println!("edge {:?} {:?} {}", um(&edge.offset), deg(&edge.angle), edge.residual_rms);
+    println!(
+        "none {:?} {:?} {}",
+        um(&none.offset),
+        deg(&none.angle),
+        none.residual_rms
+    );
+    println!(
+        "cst {:?} {:?} {}",
+        um(&cst.offset),
+        deg(&cst.angle),
+        cst.residual_rms
+    );
+    println!(
+        "edge {:?} {:?} {}",
+        um(&edge.offset),
+        deg(&edge.angle),
+        edge.residual_rms
+    );
     assert!((um(&none.offset).0 - 8.10).abs() < 0.05);
     assert!((deg(&none.angle).0 + 50.7).abs() < 0.1);
     assert!((none.residual_rms - 26.6).abs() < 0.1);
@@ -155,9 +183,21 @@ fn pooled_edge_aware_fit_matches_section_4_6() {
     assert!((deg(&edge.angle).0 + 50.7).abs() < 0.1);
     assert!((edge.residual_rms - 14.0).abs() < 0.1);
     // standard errors as in §4.6 (the spec's script: σ̂² = RSS/(n − p) covariance)
-    assert!((um(&edge.offset).1 - 1.3).abs() < 0.1, "{:?}", um(&edge.offset));
-    assert!((deg(&edge.angle).1 - 4.3).abs() < 0.2, "{:?}", deg(&edge.angle));
-    assert!((um(&none.offset).1 - 1.13).abs() < 0.05, "{:?}", um(&none.offset));
+    assert!(
+        (um(&edge.offset).1 - 1.3).abs() < 0.1,
+        "{:?}",
+        um(&edge.offset)
+    );
+    assert!(
+        (deg(&edge.angle).1 - 4.3).abs() < 0.2,
+        "{:?}",
+        deg(&edge.angle)
+    );
+    assert!(
+        (um(&none.offset).1 - 1.13).abs() < 0.05,
+        "{:?}",
+        um(&none.offset)
+    );
     let r = analyse_tests(&t, SineHypothesis::Teeth).unwrap();
     assert_eq!(r.pooled.unwrap().edge_model, EdgeModel::ConstantPlusDepth);
 }
@@ -165,10 +205,17 @@ fn pooled_edge_aware_fit_matches_section_4_6() {
 #[test]
 fn degenerate_and_exactly_determined_cases() {
     let cond = PeakConditions::new(0.1, PI / 2.0).unwrap();
-    let e = sine_fit(&ToothPeaks::new(vec![110.0, 90.0]).unwrap(), &cond, SineHypothesis::Teeth)
-        .unwrap_err();
+    let e = sine_fit(
+        &ToothPeaks::new(vec![110.0, 90.0]).unwrap(),
+        &cond,
+        SineHypothesis::Teeth,
+    )
+    .unwrap_err();
     match &e {
-        IdentifyError::DegenerateTwoTeeth { mean_n, a_sin_phi_n } => {
+        IdentifyError::DegenerateTwoTeeth {
+            mean_n,
+            a_sin_phi_n,
+        } => {
             assert_eq!((*mean_n, *a_sin_phi_n), (100.0, 10.0));
         }
         other => panic!("{other:?}"),
@@ -184,7 +231,12 @@ fn degenerate_and_exactly_determined_cases() {
         assert!((a - b).abs() < 1e-9);
     }
     // with per-tooth standard errors, K = 3 does get standard errors (propagated)
-    let f3s = sine_fit(&p3.with_se(vec![1.0; 3]).unwrap(), &cond, SineHypothesis::Teeth).unwrap();
+    let f3s = sine_fit(
+        &p3.with_se(vec![1.0; 3]).unwrap(),
+        &cond,
+        SineHypothesis::Teeth,
+    )
+    .unwrap();
     assert_eq!(f3s.error_source, ErrorSource::PerToothSe);
     // Var(C) = 1/3 for unit errors, Var(a) = Var(b) = 2/3
     assert!((f3s.mean.se.unwrap() - (1.0f64 / 3.0).sqrt()).abs() < 1e-12);

@@ -38,9 +38,9 @@ pub struct FrequencyEstimate {
 
 /// First Fourier coefficient Σ v_q e^{−jθ_q} as (re, im).
 fn first_harmonic(values: impl Iterator<Item = f64>, angles: &[f64]) -> (f64, f64) {
-    values
-        .zip(angles)
-        .fold((0.0, 0.0), |(re, im), (v, t)| (re + v * t.cos(), im - v * t.sin()))
+    values.zip(angles).fold((0.0, 0.0), |(re, im), (v, t)| {
+        (re + v * t.cos(), im - v * t.sin())
+    })
 }
 
 /// Estimate the runout vector from the spindle-frequency harmonic of the averaged waveforms,
@@ -54,21 +54,28 @@ pub fn frequency_estimate(
     let mut rhs: Vec<f64> = Vec::new();
     for case in cases {
         let n = case.waveform.validate()?;
-        let model = RevolutionModel::new(&case.cutter, &case.cut, case.waveform.start_angle, n, disks);
+        let model =
+            RevolutionModel::new(&case.cutter, &case.cut, case.waveform.start_angle, n, disks);
         let sums = model.sums([0.0, 0.0], [0.0, 0.0], false);
         let angles: Vec<f64> = (0..n).map(|q| case.waveform.angle(q)).collect();
         for comp in &case.waveform.components {
             let x1 = first_harmonic(comp.values.iter().copied(), &angles);
             let f0 = first_harmonic(
-                sums.base.iter().map(|b| force_from_basis(comp.axis, b, coefficients)),
+                sums.base
+                    .iter()
+                    .map(|b| force_from_basis(comp.axis, b, coefficients)),
                 &angles,
             );
             let gx = first_harmonic(
-                sums.deriv.iter().map(|d| runout_gradient(comp.axis, &d[0], coefficients)),
+                sums.deriv
+                    .iter()
+                    .map(|d| runout_gradient(comp.axis, &d[0], coefficients)),
                 &angles,
             );
             let gy = first_harmonic(
-                sums.deriv.iter().map(|d| runout_gradient(comp.axis, &d[1], coefficients)),
+                sums.deriv
+                    .iter()
+                    .map(|d| runout_gradient(comp.axis, &d[1], coefficients)),
                 &angles,
             );
             rows.push([gx.0, gy.0]);

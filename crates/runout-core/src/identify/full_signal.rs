@@ -118,7 +118,11 @@ fn runout_observability(p: &mut Problem<'_>) -> RunoutObservability {
     };
     let g = j.columns(0, 2).transpose() * j.columns(0, 2);
     let eig = nalgebra::SymmetricEigen::new(nalgebra::Matrix2::from_fn(|r, c| g[(r, c)]));
-    let (imax, imin) = if eig.eigenvalues[0] >= eig.eigenvalues[1] { (0, 1) } else { (1, 0) };
+    let (imax, imin) = if eig.eigenvalues[0] >= eig.eigenvalues[1] {
+        (0, 1)
+    } else {
+        (1, 0)
+    };
     let (lmax, lmin) = (eig.eigenvalues[imax], eig.eigenvalues[imin].max(0.0));
     if lmax > 0.0 && (lmin / lmax).sqrt() >= 1e-4 {
         return RunoutObservability::Full;
@@ -150,15 +154,14 @@ fn fitted_coefficients(cases: &[WaveformCase]) -> Vec<usize> {
 fn auto_disks(cases: &[WaveformCase], tilt: bool) -> usize {
     let lag = cases
         .iter()
-        .map(|c| (c.cut.ap() * c.cutter.tan_helix() / c.cutter.radius()).abs().to_degrees())
+        .map(|c| {
+            (c.cut.ap() * c.cutter.tan_helix() / c.cutter.radius())
+                .abs()
+                .to_degrees()
+        })
         .fold(0.0, f64::max);
     let d = (lag / 0.1).ceil().max(1.0) as usize;
-    if tilt {
-        d.max(8)
-    } else {
-        d
-    }
-    .min(2000)
+    if tilt { d.max(8) } else { d }.min(2000)
 }
 
 #[derive(Clone)]
@@ -213,7 +216,11 @@ impl Problem<'_> {
     }
     fn weight(&self, c: usize, comp: usize, q: usize) -> f64 {
         if self.weights {
-            self.cases[c].waveform.components[comp].se.as_ref().map(|s| s[q]).unwrap_or(1.0)
+            self.cases[c].waveform.components[comp]
+                .se
+                .as_ref()
+                .map(|s| s[q])
+                .unwrap_or(1.0)
         } else {
             1.0
         }
@@ -353,7 +360,9 @@ fn linear_coefficients(p: &mut Problem<'_>) -> Result<(), IdentifyError> {
     let jac = p.jacobian().expect("jacobian");
     let x = jac.columns(nr, ncoef).into_owned();
     // residuals at zero coefficients = −measured/w
-    let y = -p.residuals().ok_or_else(|| IdentifyError::singular("full-signal fit", "non-finite data"))?;
+    let y = -p
+        .residuals()
+        .ok_or_else(|| IdentifyError::singular("full-signal fit", "non-finite data"))?;
     let fit = linear_lsq("coefficient start values", &x, &y)?;
     for c in 0..ncoef {
         p.x[nr + c] = fit.beta[c];
@@ -386,14 +395,23 @@ pub fn full_signal_fit(
     let weights = cases
         .iter()
         .all(|c| c.waveform.components.iter().all(|k| k.se.is_some()));
-    let disks = options.disks.unwrap_or_else(|| auto_disks(cases, options.fit_tilt)).max(1);
+    let disks = options
+        .disks
+        .unwrap_or_else(|| auto_disks(cases, options.fit_tilt))
+        .max(1);
     let coef_idx = fitted_coefficients(cases);
     let nr_full = if options.fit_tilt { 4 } else { 2 };
     let np_full = nr_full + coef_idx.len();
     let models: Vec<RevolutionModel> = cases
         .iter()
         .map(|c| {
-            RevolutionModel::new(&c.cutter, &c.cut, c.waveform.start_angle, c.waveform.samples(), disks)
+            RevolutionModel::new(
+                &c.cutter,
+                &c.cut,
+                c.waveform.start_angle,
+                c.waveform.samples(),
+                disks,
+            )
         })
         .collect();
     let mut problem = Problem {
@@ -464,9 +482,7 @@ pub fn full_signal_fit(
     for (_, x) in scored.iter().take(2) {
         let mut start = problem.clone();
         start.set_params(x);
-        let (done, report) = LevenbergMarquardt::new()
-            .with_patience(200)
-            .minimize(start);
+        let (done, report) = LevenbergMarquardt::new().with_patience(200).minimize(start);
         let better = best
             .as_ref()
             .is_none_or(|(_, r)| report.objective_function < r.objective_function);
@@ -493,13 +509,25 @@ pub fn full_signal_fit(
     let s2 = rss_w / dof as f64;
 
     // Condition number of the column-normalised Jacobian, and the covariance.
-    let norms: Vec<f64> = (0..np).map(|c| jac.column(c).norm().max(f64::MIN_POSITIVE)).collect();
+    let norms: Vec<f64> = (0..np)
+        .map(|c| jac.column(c).norm().max(f64::MIN_POSITIVE))
+        .collect();
     let jn = DMatrix::from_fn(n, np, |r, c| jac[(r, c)] / norms[c]);
     let svd = jn.svd(false, true);
     let (smax, smin) = (svd.singular_values.max(), svd.singular_values.min());
-    let condition = if smin > 0.0 { smax / smin } else { f64::INFINITY };
+    let condition = if smin > 0.0 {
+        smax / smin
+    } else {
+        f64::INFINITY
+    };
     let v_t = svd.v_t.as_ref().expect("V computed");
-    let inv = DMatrix::from_diagonal(&svd.singular_values.map(|s| if s > 0.0 { 1.0 / (s * s) } else { f64::INFINITY }));
+    let inv = DMatrix::from_diagonal(&svd.singular_values.map(|s| {
+        if s > 0.0 {
+            1.0 / (s * s)
+        } else {
+            f64::INFINITY
+        }
+    }));
     let cov_n = v_t.transpose() * inv * v_t;
     let cov = DMatrix::from_fn(np, np, |r, c| cov_n[(r, c)] * s2 / (norms[r] * norms[c]));
     let se = |i: usize| cov[(i, i)].max(0.0).sqrt();
@@ -543,7 +571,10 @@ pub fn full_signal_fit(
         vec!["e_along_tooth_line_um".to_string()]
     };
     if options.fit_tilt {
-        parameters.extend(["tilt_x_um_per_mm".to_string(), "tilt_y_um_per_mm".to_string()]);
+        parameters.extend([
+            "tilt_x_um_per_mm".to_string(),
+            "tilt_y_um_per_mm".to_string(),
+        ]);
     }
     parameters.extend(coef_idx.iter().map(|&i| NAMES[i].to_string()));
 
@@ -556,7 +587,7 @@ pub fn full_signal_fit(
         }
     }
     let rss: f64 = raw.iter().map(|r| r * r).sum();
-    let ill = !(condition < 1e8);
+    let ill = condition.is_nan() || condition >= 1e8;
     let mut warnings = Vec::new();
     if ill {
         warnings.push(format!(
@@ -589,8 +620,14 @@ pub fn full_signal_fit(
         },
         observability,
         vector: [
-            Estimate { value: ex, se: Some(cov_e[0][0].max(0.0).sqrt()) },
-            Estimate { value: ey, se: Some(cov_e[1][1].max(0.0).sqrt()) },
+            Estimate {
+                value: ex,
+                se: Some(cov_e[0][0].max(0.0).sqrt()),
+            },
+            Estimate {
+                value: ey,
+                se: Some(cov_e[1][1].max(0.0).sqrt()),
+            },
         ],
         tilt: options.fit_tilt.then(|| {
             [

@@ -50,16 +50,12 @@ pub fn linear_lsq(
 ) -> Result<LinearFit, IdentifyError> {
     let (n, p) = x.shape();
     if n < p {
-        return Err(IdentifyError::too_few(
-            what,
-            format!("{p} observations"),
-            n,
-        ));
+        return Err(IdentifyError::too_few(what, format!("{p} observations"), n));
     }
     let svd = x.clone().svd(true, true);
     let smax = svd.singular_values.max();
     let smin = svd.singular_values.min();
-    if !(smax > 0.0) || smin <= 1e-12 * smax {
+    if smax.is_nan() || smax <= 0.0 || smin <= 1e-12 * smax {
         return Err(IdentifyError::singular(
             what,
             format!("design matrix rank deficient (singular values {smin:.3e} .. {smax:.3e})"),

@@ -47,7 +47,7 @@ pub fn coefficients_at_peak(
     positive("fz_mm", fz_mm)?;
     positive("ap_mm", ap_mm)?;
     let (s, c) = theta_rad.sin_cos();
-    if !(s > 1e-6) {
+    if s.is_nan() || s <= 1e-6 {
         return Err(ParamError::new(
             "peak_immersion_deg",
             "an angle with sin θ > 0",

@@ -117,7 +117,7 @@ impl PeakConditions {
     pub fn new(fz_mm: f64, peak_immersion_rad: f64) -> Result<Self, ParamError> {
         positive("fz_mm", fz_mm)?;
         let s = peak_immersion_rad.sin();
-        if !(s > 1e-6) {
+        if s.is_nan() || s <= 1e-6 {
             return Err(ParamError::new(
                 "peak_immersion_deg",
                 "an immersion angle with sin γ > 0 (0 < γ < 180°)",
@@ -283,7 +283,8 @@ pub fn sine_fit(
 
     let (cov, error_source) = match (peaks.se(), fit0.sigma2()) {
         (Some(se), _) => {
-            let sigma = DMatrix::from_diagonal(&DVector::from_iterator(k, se.iter().map(|s| s * s)));
+            let sigma =
+                DMatrix::from_diagonal(&DVector::from_iterator(k, se.iter().map(|s| s * s)));
             (Some(&l * sigma * l.transpose()), ErrorSource::PerToothSe)
         }
         (None, Some(s2)) => (Some(&l * l.transpose() * s2), ErrorSource::Residuals),

@@ -113,7 +113,11 @@ impl AveragedWaveform {
     ) -> Result<Self, ParamError> {
         let len = series.first().map(|s| s.1.len()).unwrap_or(0);
         if samples_per_rev < 8 {
-            return Err(ParamError::new("samples_per_rev", "an integer >= 8", samples_per_rev));
+            return Err(ParamError::new(
+                "samples_per_rev",
+                "an integer >= 8",
+                samples_per_rev,
+            ));
         }
         let m = len / samples_per_rev;
         if m < 1 {
