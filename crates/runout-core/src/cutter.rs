@@ -102,7 +102,7 @@ impl Cutter {
                 helix,
             ));
         }
-        if !(flute_length_mm > 0.0) {
+        if flute_length_mm.is_nan() || flute_length_mm <= 0.0 {
             return Err(ParamError::new(
                 "flute_length_mm",
                 "a length > 0 (mm)",

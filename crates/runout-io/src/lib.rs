@@ -6,5 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod config;
+pub mod export;
 pub mod plot;
+pub mod recording;
 pub mod units;

@@ -1,6 +1,8 @@
 //! Plots (SVG and PNG by file extension) with plotters. PNG text is rasterised from an embedded
 //! DejaVu Sans font (Bitstream Vera licence), so no system fonts are needed.
 
+pub mod identify;
+
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use runout_core::{ForceSeries, ToothPeak};
@@ -149,13 +151,15 @@ fn draw_forces<DB: DrawingBackend>(
     let all = s.fx.iter().chain(&s.fy).chain(&s.fz).chain(&fxy);
     let (lo, hi) = all.fold((0.0f64, 0.0f64), |(l, h), v| (l.min(*v), h.max(*v)));
     let pad = 0.05 * (hi - lo).max(1e-9);
+    // headroom above the data for the legend, so it never hides a peak marker
+    let top = hi + 0.45 * (hi - lo).max(1e-9);
     let x1 = ang.last().copied().unwrap_or(360.0).max(1e-9);
     let mut chart = ChartBuilder::on(root)
         .caption(title, ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(0.0..x1, (lo - pad)..(hi + pad))
+        .build_cartesian_2d(0.0..x1, (lo - pad)..top)
         .map_err(e2s)?;
     chart
         .configure_mesh()

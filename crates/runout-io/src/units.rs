@@ -56,7 +56,7 @@ impl Quantity {
     /// Factor from `suffix` to the canonical unit, or `None` if the suffix is not of this quantity.
     fn factor(self, suffix: &str) -> Option<f64> {
         let s = suffix.trim();
-        let s = s.replace('²', "2").replace('µ', "u").replace('μ', "u");
+        let s = s.replace('²', "2").replace(['µ', 'μ'], "u");
         let s = s.as_str();
         let length_mm = match s {
             "mm" => Some(1.0),

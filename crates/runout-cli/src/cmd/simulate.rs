@@ -5,7 +5,9 @@ use anyhow::{Context, Result};
 use runout_core::{tooth_peaks, ArcChip, ForceModel, ForceSeries, ToothPeak};
 use runout_io::config::simulate::{resolve_simulate, simulate_key_names, SimulateCase};
 use runout_io::config::{layer_from_toml, Layer, Settings, Value};
+use runout_io::units::{parse_quantity, Quantity};
 use serde_json::json;
+use std::io::Write;
 use std::path::PathBuf;
 
 /// Flags of `runout simulate`. Every config key is also a flag; flags override the file.
@@ -101,14 +103,42 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     pub chip_model: Option<String>,
     /// Write the force time series as CSV (time_s, angle_deg, fx_N, fy_N, fz_N, torque_Nm, h<i>_mm); `-` for stdout.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long)]
     pub out: Option<PathBuf>,
     /// Write the JSON summary (inputs, per-tooth peaks, mean forces); `-` for stdout.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long)]
     pub json: Option<PathBuf>,
     /// Plot forces vs spindle angle with each tooth's peak marked (.svg or .png).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long)]
     pub plot: Option<PathBuf>,
+    #[command(flatten)]
+    pub recording: RecordingFlags,
+}
+
+/// Options for writing the simulated cut as an instrument recording (a test or example input).
+#[derive(clap::Args, Debug, Default)]
+pub struct RecordingFlags {
+    /// Write the forces as a Kistler DynoWare text export (channels Fx, Fy, Fz in N, workpiece frame).
+    #[arg(long)]
+    pub recording: Option<PathBuf>,
+    /// Sample rate of the recording (Hz); sets the angular step to 360·rpm/(60·rate).
+    #[arg(long)]
+    pub sample_rate_hz: Option<String>,
+    /// Gaussian white noise added to each channel, σ in percent of the peak |F_xy| of the cut.
+    #[arg(long, default_value = "0")]
+    pub noise_percent: String,
+    /// Air cut (no force, noise only) before and after the cut (s).
+    #[arg(long, default_value = "0")]
+    pub air_cut_s: String,
+    /// Seed of the noise generator (integer).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Field delimiter of the recording: comma | semicolon | tab.
+    #[arg(long, default_value = "comma")]
+    pub delimiter: String,
+    /// Write decimal commas (needs --delimiter semicolon or tab).
+    #[arg(long)]
+    pub decimal_comma: bool,
 }
 
 impl CaseFlags {
@@ -175,9 +205,27 @@ pub fn run(a: Args) -> Result<()> {
         ("chip_model", &a.chip_model),
     ]);
     let s = settings(a.config.as_deref(), flags, &simulate_key_names())?;
-    let case = resolve_simulate(&s)?;
+    let mut case = resolve_simulate(&s)?;
+    let rate = a
+        .recording
+        .sample_rate_hz
+        .as_deref()
+        .map(|t| parse_flag("--sample-rate-hz", t, Quantity::FrequencyHz))
+        .transpose()?;
+    if let Some(fs) = rate {
+        if fs <= 0.0 {
+            anyhow::bail!("--sample-rate-hz: expected a sample rate > 0 Hz, got {fs}");
+        }
+        let step_deg = 360.0 * case.cut.rpm() / 60.0 / fs;
+        case.sampling =
+            runout_core::Sampling::new(case.sampling.revolutions, step_deg, case.sampling.disks)
+                .map_err(|e| anyhow::anyhow!("--sample-rate-hz {fs}: {e}"))?;
+    }
     let inputs: Vec<&std::path::Path> = a.config.iter().map(|p| p.as_path()).collect();
-    for out in [&a.out, &a.json, &a.plot].into_iter().flatten() {
+    for out in [&a.out, &a.json, &a.plot, &a.recording.recording]
+        .into_iter()
+        .flatten()
+    {
         output::check_not_input(out, &inputs)?;
     }
 
@@ -193,6 +241,10 @@ pub fn run(a: Args) -> Result<()> {
 
     if let Some(out) = &a.out {
         write_csv(out, &series)?;
+    }
+    if let Some(path) = &a.recording.recording {
+        let fs = rate.ok_or_else(|| anyhow::anyhow!("--recording needs --sample-rate-hz"))?;
+        write_recording(path, fs, &series, &a.recording)?;
     }
     let summary = summary_json(&case, &series, &peaks);
     if let Some(j) = &a.json {
@@ -213,8 +265,85 @@ pub fn run(a: Args) -> Result<()> {
     Ok(())
 }
 
+fn parse_flag(flag: &str, text: &str, q: Quantity) -> Result<f64> {
+    parse_quantity(text, q).map_err(|e| anyhow::anyhow!("{flag}: {e}"))
+}
+
+/// The simulated cut as a DynoWare text export, with air-cut padding and white noise.
+fn write_recording(
+    path: &std::path::Path,
+    fs: f64,
+    s: &ForceSeries,
+    r: &RecordingFlags,
+) -> Result<()> {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+    let pct = parse_flag("--noise-percent", &r.noise_percent, Quantity::Dimensionless)?;
+    let air = parse_flag("--air-cut-s", &r.air_cut_s, Quantity::TimeS)?;
+    if pct < 0.0 || air < 0.0 {
+        anyhow::bail!("--noise-percent and --air-cut-s must be >= 0 (got {pct}, {air})");
+    }
+    let delimiter = match r.delimiter.as_str() {
+        "comma" => ',',
+        "semicolon" => ';',
+        "tab" => '\t',
+        other => anyhow::bail!("--delimiter: expected comma, semicolon or tab, got `{other}`"),
+    };
+    let peak = s.fxy().into_iter().fold(0.0, f64::max);
+    let sigma = pct / 100.0 * peak;
+    let normal = Normal::new(0.0, sigma.max(0.0)).map_err(|e| anyhow::anyhow!("noise: {e}"))?;
+    let mut rng = rand::rngs::StdRng::seed_from_u64(r.seed);
+    let pad = (air * fs).round() as usize;
+    let mut channel = |v: &[f64]| -> Vec<f64> {
+        let mut out = vec![0.0; pad];
+        out.extend_from_slice(v);
+        out.extend(std::iter::repeat_n(0.0, pad));
+        if sigma > 0.0 {
+            out.iter_mut().for_each(|x| *x += normal.sample(&mut rng));
+        }
+        out
+    };
+    let (fx, fy, fz) = (channel(&s.fx), channel(&s.fy), channel(&s.fz));
+    let style = runout_io::export::TextStyle {
+        delimiter,
+        decimal_comma: r.decimal_comma,
+    };
+    let mut w = output::create(path)?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().replace(".txt", ".dwd"))
+        .unwrap_or_default();
+    let noise = format!("{pct}% of peak |F_xy| ({sigma:.3} N)");
+    let meta = [
+        ("Filename", name.as_str()),
+        ("Cycle No", "1"),
+        ("Comment", "simulated by runout simulate"),
+        ("Noise", noise.as_str()),
+    ];
+    let chans = [
+        runout_io::export::Channel {
+            name: "Fx",
+            unit: "N",
+            data: &fx,
+        },
+        runout_io::export::Channel {
+            name: "Fy",
+            unit: "N",
+            data: &fy,
+        },
+        runout_io::export::Channel {
+            name: "Fz",
+            unit: "N",
+            data: &fz,
+        },
+    ];
+    runout_io::export::write_dynoware(&mut w, fs, &meta, &chans, style)
+        .with_context(|| format!("writing {}", path.display()))?;
+    w.flush()?;
+    Ok(())
+}
+
 fn write_csv(dest: &std::path::Path, s: &ForceSeries) -> Result<()> {
-    use std::io::Write;
     let mut w = output::create(dest)?;
     let k = s.chip.len();
     write!(w, "time_s,angle_deg,fx_N,fy_N,fz_N,torque_Nm")?;

@@ -39,6 +39,9 @@ pub struct Sampling {
 }
 
 impl Sampling {
+    /// Largest number of angle samples one simulation holds in memory (≈ 5 GB of output).
+    pub const MAX_SAMPLES: usize = 100_000_000;
+
     /// `revolutions` turns at `step_deg` degrees per sample with `disks` axial disks.
     pub fn new(revolutions: f64, step_deg: f64, disks: usize) -> Result<Self, ParamError> {
         positive("revolutions", revolutions)?;
@@ -52,6 +55,17 @@ impl Sampling {
         }
         if disks == 0 {
             return Err(ParamError::new("disks", "an integer >= 1", disks));
+        }
+        let samples = revolutions * 360.0 / step_deg;
+        if samples > Self::MAX_SAMPLES as f64 {
+            return Err(ParamError::new(
+                "revolutions",
+                format!(
+                    "at most {} samples in one simulation (revolutions·360/step_deg)",
+                    Self::MAX_SAMPLES
+                ),
+                format!("{revolutions} revolutions at {step_deg}° = {samples:.3e} samples"),
+            ));
         }
         Ok(Sampling {
             revolutions,

@@ -84,6 +84,11 @@ impl Settings {
             .find_map(|l| l.values.get(key).map(|v| (l.origin.as_str(), v)))
     }
 
+    /// Where `key` was set (file name or "command line"), if anywhere.
+    pub fn origin(&self, key: &str) -> Option<&str> {
+        self.lookup(key).map(|(o, _)| o)
+    }
+
     /// True if any layer sets `key`.
     pub fn has(&self, key: &str) -> bool {
         self.lookup(key).is_some()

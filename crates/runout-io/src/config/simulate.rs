@@ -139,9 +139,11 @@ pub struct SimulateCase {
     pub chip_model: String,
 }
 
-fn key_err(settings_origin: &str, e: ParamError) -> ConfigError {
+/// A model error for `e.param`, attributed to the layer that set that key.
+fn key_err(s: &Settings, e: ParamError) -> ConfigError {
+    let origin = s.origin(&e.param).unwrap_or("defaults").to_string();
     ConfigError::Key {
-        source_name: settings_origin.into(),
+        source_name: origin,
         key: e.param.clone(),
         message: format!("expected {}, got {}", e.expected, e.got),
     }
@@ -158,7 +160,6 @@ fn key_err(settings_origin: &str, e: ParamError) -> ConfigError {
 /// assert!((case.runout.offset() - 0.008).abs() < 1e-15);
 /// ```
 pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
-    let o = "config";
     let teeth = s.count("teeth")?.ok_or_else(|| ConfigError::Missing {
         key: "teeth".into(),
         flag: "teeth".into(),
@@ -166,7 +167,7 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
     })?;
     if teeth == 0 {
         return Err(ConfigError::Key {
-            source_name: o.into(),
+            source_name: s.origin("teeth").unwrap_or("config").into(),
             key: "teeth".into(),
             message: "expected an integer >= 1, got 0".into(),
         });
@@ -185,7 +186,7 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
         Some(p) => {
             if p.len() != teeth {
                 return Err(ConfigError::Key {
-                    source_name: o.into(),
+                    source_name: s.origin("pitch_deg").unwrap_or("config").into(),
                     key: "pitch_deg".into(),
                     message: format!(
                         "expected {teeth} pitch angles (one per tooth), got {}",
@@ -202,12 +203,22 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
             )
         }
     }
-    .map_err(|e| key_err(o, e))?;
+    .map_err(|e| key_err(s, e))?;
 
     let rpm = s.require("rpm", Quantity::SpeedRpm, "spindle speed")?;
     let fz = s.require("fz_mm", Quantity::LengthMm, "feed per tooth")?;
     let ap = s.require("ap_mm", Quantity::LengthMm, "axial depth of cut")?;
-    let base = Cut::new(rpm, fz, ap).map_err(|e| key_err(o, e))?;
+    let base = Cut::new(rpm, fz, ap).map_err(|e| key_err(s, e))?;
+    if ap > cutter.flute_length() {
+        return Err(ConfigError::Key {
+            source_name: s.origin("ap_mm").unwrap_or("config").into(),
+            key: "ap_mm".into(),
+            message: format!(
+                "expected an axial depth within the flute length {} mm, got {ap}",
+                cutter.flute_length()
+            ),
+        });
+    }
     let cut = if s.has("entry_deg") || s.has("exit_deg") {
         let en = s.require("entry_deg", Quantity::AngleDeg, "entry angle")?;
         let ex = s.require("exit_deg", Quantity::AngleDeg, "exit angle")?;
@@ -218,7 +229,7 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
             flag: "mode".into(),
             what: "up, down or slot".into(),
         })?;
-        let mode: MillingMode = mode_text.parse().map_err(|e| key_err(o, e))?;
+        let mode: MillingMode = mode_text.parse().map_err(|e| key_err(s, e))?;
         let ae = if mode == MillingMode::Slot {
             d
         } else {
@@ -226,7 +237,7 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
         };
         base.radial(ae, mode, &cutter)
     }
-    .map_err(|e| key_err(o, e))?;
+    .map_err(|e| key_err(s, e))?;
 
     let rho = s.or("runout_um", Quantity::LengthUm, 0.0)? * 1e-3;
     let lam = s.or("runout_angle_deg", Quantity::AngleDeg, 0.0)?;
@@ -234,7 +245,7 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
     let tilt_ang = s.or("tilt_angle_deg", Quantity::AngleDeg, 0.0)?;
     let runout = Runout::new(rho, lam.to_radians())
         .and_then(|r| r.with_tilt(tilt, tilt_ang.to_radians()))
-        .map_err(|e| key_err(o, e))?;
+        .map_err(|e| key_err(s, e))?;
 
     let coefficients = CuttingCoefficients::new(
         [
@@ -248,18 +259,18 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
             s.or("kae", Quantity::ForcePerLength, 0.0)?,
         ],
     )
-    .map_err(|e| key_err(o, e))?;
+    .map_err(|e| key_err(s, e))?;
 
     let revolutions = s.or("revolutions", Quantity::Dimensionless, 2.0)?;
     let step = s.or("step_deg", Quantity::AngleDeg, 0.5)?;
     let disks = s
         .count("disks")?
         .unwrap_or(if helix == 0.0 { 1 } else { 50 });
-    let sampling = Sampling::new(revolutions, step, disks).map_err(|e| key_err(o, e))?;
+    let sampling = Sampling::new(revolutions, step, disks).map_err(|e| key_err(s, e))?;
     let chip_model = s.text("chip_model")?.unwrap_or_else(|| "arc".into());
     if chip_model != "arc" {
         return Err(ConfigError::Key {
-            source_name: o.into(),
+            source_name: s.origin("chip_model").unwrap_or("config").into(),
             key: "chip_model".into(),
             message: format!("expected one of: arc; got `{chip_model}`"),
         });

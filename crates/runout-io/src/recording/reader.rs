@@ -1,0 +1,788 @@
+//! The streaming reader: header interpretation at open, then data rows parsed chunk by chunk.
+
+use super::error::RecordingError;
+use super::header::{
+    detect_decimal_comma, detect_delimiter, is_unit_row, key_line, meta_number, split_unit,
+};
+use super::text::{binary_issue, decode, fields, parse_number, trim_field};
+use super::{Channel, Chunk, Format, ReadOptions, RecordingInfo};
+use std::collections::VecDeque;
+use std::fs::File;
+use std::io::{BufRead, BufReader, Read};
+use std::path::Path;
+
+type Result<T> = std::result::Result<T, RecordingError>;
+
+/// Longest accepted line; a longer one is reported (bounded memory on garbage input).
+const MAX_LINE_BYTES: u64 = 1 << 20;
+/// Data rows inspected at open for the decimal separator and the time step.
+const PEEK_ROWS: usize = 1000;
+/// Default rows per chunk.
+pub const DEFAULT_CHUNK_ROWS: usize = 65_536;
+
+/// Lines of the input with their 1-based numbers; lines read ahead wait in `pending`.
+struct LineSource<R> {
+    src: R,
+    pending: VecDeque<(u64, Vec<u8>)>,
+    line_no: u64,
+    bytes: u64,
+    file: String,
+}
+
+impl<R: BufRead> LineSource<R> {
+    /// Next line from the underlying reader (not from `pending`), without its line ending.
+    fn read_src(&mut self, buf: &mut Vec<u8>) -> Result<Option<u64>> {
+        buf.clear();
+        let n = (&mut self.src)
+            .take(MAX_LINE_BYTES)
+            .read_until(b'\n', buf)
+            .map_err(|source| RecordingError::Io {
+                file: self.file.clone(),
+                source,
+            })?;
+        if n == 0 {
+            return Ok(None);
+        }
+        self.bytes += n as u64;
+        self.line_no += 1;
+        if buf.last() == Some(&b'\n') {
+            buf.pop();
+        } else if n as u64 == MAX_LINE_BYTES {
+            return Err(RecordingError::Binary {
+                file: self.file.clone(),
+                line: self.line_no,
+                detail: format!("line longer than {MAX_LINE_BYTES} bytes"),
+            });
+        }
+        if buf.last() == Some(&b'\r') {
+            buf.pop();
+        }
+        if self.line_no == 1 {
+            if buf.starts_with(&[0xEF, 0xBB, 0xBF]) {
+                buf.drain(..3);
+            } else if buf.starts_with(&[0xFF, 0xFE]) || buf.starts_with(&[0xFE, 0xFF]) {
+                return Err(RecordingError::Binary {
+                    file: self.file.clone(),
+                    line: 1,
+                    detail: "UTF-16 text; export the recording as UTF-8 or ANSI text".into(),
+                });
+            }
+        }
+        Ok(Some(self.line_no))
+    }
+
+    /// Next line, first from the read-ahead queue.
+    fn next(&mut self, buf: &mut Vec<u8>) -> Result<Option<u64>> {
+        if let Some((n, line)) = self.pending.pop_front() {
+            *buf = line;
+            return Ok(Some(n));
+        }
+        self.read_src(buf)
+    }
+
+    /// Next non-blank line, checked to be text.
+    fn next_nonblank(&mut self, buf: &mut Vec<u8>) -> Result<Option<u64>> {
+        while let Some(n) = self.next(buf)? {
+            self.check_text(n, buf)?;
+            if !trim_field(buf).is_empty() {
+                return Ok(Some(n));
+            }
+        }
+        Ok(None)
+    }
+
+    fn check_text(&self, line: u64, buf: &[u8]) -> Result<()> {
+        match binary_issue(buf) {
+            Some(detail) => Err(RecordingError::Binary {
+                file: self.file.clone(),
+                line,
+                detail,
+            }),
+            None => Ok(()),
+        }
+    }
+}
+
+/// What to do with each field of a data row.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Slot {
+    Skip,
+    Time,
+    Channel(usize),
+}
+
+/// A streaming reader of one recording (generic CSV/TSV or Kistler DynoWare text export).
+///
+/// Opening reads only the header and up to 1000 data rows (kept for the reader); then
+/// [`RecordingReader::read_chunk`] parses rows into a reusable [`Chunk`], so memory is bounded by
+/// the chunk size whatever the file length. After an error the reader is finished.
+pub struct RecordingReader<R> {
+    lines: LineSource<R>,
+    info: RecordingInfo,
+    slots: Vec<Slot>,
+    time_scale: f64,
+    time_column: usize,
+    sample: u64,
+    previous_time: f64,
+    warnings: Vec<String>,
+    buf: Vec<u8>,
+    chunk_rows: usize,
+    finished: bool,
+}
+
+impl RecordingReader<BufReader<File>> {
+    /// Open a file and read its header (see [`RecordingReader::from_reader`]).
+    pub fn open(path: impl AsRef<Path>, options: &ReadOptions) -> Result<Self> {
+        let path = path.as_ref();
+        let file = path.display().to_string();
+        let f = File::open(path).map_err(|source| RecordingError::Io {
+            file: file.clone(),
+            source,
+        })?;
+        let mut r = Self::from_reader(BufReader::with_capacity(1 << 16, f), &file, options)?;
+        r.info.file_bytes = std::fs::metadata(path).ok().map(|m| m.len());
+        Ok(r)
+    }
+}
+
+impl<'a> RecordingReader<std::io::Cursor<&'a [u8]>> {
+    /// Read a recording held in memory; `name` is used in messages.
+    pub fn from_bytes(name: &str, bytes: &'a [u8], options: &ReadOptions) -> Result<Self> {
+        let mut r = Self::from_reader(std::io::Cursor::new(bytes), name, options)?;
+        r.info.file_bytes = Some(bytes.len() as u64);
+        Ok(r)
+    }
+}
+
+impl<R: BufRead> RecordingReader<R> {
+    /// Read the header of a recording from `src`; `file` names it in messages.
+    ///
+    /// Recognises a DynoWare export by its first line (`DynoWare,Version …`), else a generic
+    /// CSV/TSV with a header row and an optional unit row. The delimiter (comma, semicolon, tab)
+    /// and decimal commas are detected. The sample rate is, in order: `options.sample_rate_hz`,
+    /// the DynoWare `Sampling rate [Hz]` line, the time column's step; a time column is then
+    /// checked row by row against it (strictly increasing, within half a sample period).
+    pub fn from_reader(src: R, file: &str, options: &ReadOptions) -> Result<Self> {
+        options.validate(file)?;
+        let mut lines = LineSource {
+            src,
+            pending: VecDeque::new(),
+            line_no: 0,
+            bytes: 0,
+            file: file.to_string(),
+        };
+        let mut buf = Vec::new();
+        let Some(first_no) = lines.next_nonblank(&mut buf)? else {
+            return Err(RecordingError::Empty { file: file.into() });
+        };
+        let mut warnings = Vec::new();
+        let header = if buf.len() >= 8 && buf[..8].eq_ignore_ascii_case(b"dynoware") {
+            read_dynoware_header(&mut lines, &mut buf, first_no, &mut warnings)?
+        } else {
+            read_generic_header(&mut lines, &mut buf, first_no)?
+        };
+        // read ahead the first data rows
+        let mut peeked = 0;
+        while peeked < PEEK_ROWS {
+            let mut l = Vec::new();
+            match lines.read_src(&mut l)? {
+                Some(n) => {
+                    if !trim_field(&l).is_empty() {
+                        peeked += 1;
+                    }
+                    lines.pending.push_back((n, l));
+                }
+                None => break,
+            }
+        }
+        let first_data = lines
+            .pending
+            .iter()
+            .find(|(_, l)| !trim_field(l).is_empty())
+            .map(|(n, l)| (*n, l.clone()));
+        let Some((_, first_data)) = first_data else {
+            return Err(RecordingError::NoData {
+                file: file.into(),
+                line: lines.line_no + 1,
+            });
+        };
+        let delim = header.delimiter;
+        let decimal_comma = detect_decimal_comma(&first_data, delim);
+        Self::assemble(lines, header, decimal_comma, options, warnings)
+    }
+
+    /// Resolve columns, sample rate and time checks from the parsed header.
+    fn assemble(
+        lines: LineSource<R>,
+        header: HeaderParts,
+        decimal_comma: bool,
+        options: &ReadOptions,
+        mut warnings: Vec<String>,
+    ) -> Result<Self> {
+        let file = lines.file.clone();
+        let columns = header.columns(&mut warnings);
+        let available = columns
+            .iter()
+            .map(|c| c.header.clone())
+            .collect::<Vec<_>>()
+            .join(", ");
+        let missing = |name: &str| RecordingError::MissingColumn {
+            file: file.clone(),
+            line: header.names_line,
+            name: name.to_string(),
+            available: available.clone(),
+        };
+        let time = match &options.time_column {
+            Some(name) => Some(find_column(&columns, name).ok_or_else(|| missing(name))?),
+            None => columns.iter().position(|c| {
+                matches!(
+                    c.name.to_ascii_lowercase().as_str(),
+                    "time" | "t" | "zeit" | "timestamp"
+                )
+            }),
+        };
+        let selected: Vec<usize> = match &options.channels {
+            Some(names) => names
+                .iter()
+                .map(|n| find_column(&columns, n).ok_or_else(|| missing(n)))
+                .collect::<Result<_>>()?,
+            None => (0..columns.len()).filter(|&i| Some(i) != time).collect(),
+        };
+        let mut slots = vec![Slot::Skip; columns.len()];
+        for (k, &i) in selected.iter().enumerate() {
+            slots[i] = Slot::Channel(k);
+        }
+        let time_scale = match time {
+            Some(i) => {
+                slots[i] = Slot::Time;
+                time_unit_scale(&columns[i]).ok_or_else(|| RecordingError::Header {
+                    file: file.clone(),
+                    line: header.names_line,
+                    message: format!(
+                        "time column `{}` has unit `{}`; expected s, ms or us",
+                        columns[i].header,
+                        columns[i].unit.clone().unwrap_or_default()
+                    ),
+                })?
+            }
+            None => 1.0,
+        };
+        // sample rate: caller, DynoWare header, time column
+        let times: Vec<f64> = match time {
+            Some(i) => lines
+                .pending
+                .iter()
+                .filter(|(_, l)| !trim_field(l).is_empty())
+                .map_while(|(_, l)| {
+                    fields(l, header.delimiter)
+                        .nth(i)
+                        .and_then(|f| parse_number(f, decimal_comma))
+                })
+                .map(|t| t * time_scale)
+                .collect(),
+            None => Vec::new(),
+        };
+        let meta_rate = header.sampling_rate(decimal_comma);
+        // rate over the strictly increasing prefix (a later defect is reported at its line)
+        let increasing = 1 + times.windows(2).take_while(|w| w[1] > w[0]).count();
+        let times = &times[..increasing.min(times.len())];
+        let time_rate = (times.len() >= 2)
+            .then(|| (times.len() - 1) as f64 / (times[times.len() - 1] - times[0]))
+            .filter(|f| f.is_finite() && *f > 0.0);
+        let (rate, source) = if let Some(f) = options.sample_rate_hz {
+            if let Some(m) = meta_rate {
+                if ((m - f) / f).abs() > 1e-9 {
+                    warnings.push(format!(
+                        "{file}: sample rate {f} Hz given, but the header says {m} Hz; using {f} Hz"
+                    ));
+                }
+            }
+            (f, "given by the caller".to_string())
+        } else if let Some(m) = meta_rate {
+            (m, "from the header's sampling-rate line".to_string())
+        } else if let Some(t) = time_rate {
+            (t, "estimated from the time column's first rows".to_string())
+        } else {
+            let extra = if time.is_some() {
+                " with at least two valid rows".to_string()
+            } else {
+                String::new()
+            };
+            return Err(RecordingError::NoSampleRate { file, extra });
+        };
+        let start = options.start_time_s.unwrap_or(0.0);
+        let info = RecordingInfo {
+            file: file.clone(),
+            format: header.format.clone(),
+            delimiter: header.delimiter as char,
+            decimal_comma,
+            metadata: header.metadata.clone(),
+            time_column: time.map(|i| columns[i].clone()),
+            channels: selected.iter().map(|&i| columns[i].clone()).collect(),
+            columns,
+            sample_rate_hz: rate,
+            sample_rate_source: source,
+            start_time_s: times.first().copied().unwrap_or(start),
+            expected_samples: header.expected_samples(),
+            header_lines: header.last_line,
+            file_bytes: None,
+        };
+        Ok(Self {
+            lines,
+            info,
+            slots,
+            time_scale,
+            time_column: time.map_or(0, |i| i + 1),
+            sample: 0,
+            previous_time: f64::NEG_INFINITY,
+            warnings,
+            buf: Vec::new(),
+            chunk_rows: if options.chunk_rows == 0 {
+                DEFAULT_CHUNK_ROWS
+            } else {
+                options.chunk_rows
+            },
+            finished: false,
+        })
+    }
+
+    /// What the header said: format, channels, units, metadata, sample rate.
+    pub fn info(&self) -> &RecordingInfo {
+        &self.info
+    }
+
+    /// Non-fatal findings so far (rate given vs header, sample count vs header, unit clashes).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// Bytes consumed from the input so far (for progress bars), including read-ahead.
+    pub fn bytes_read(&self) -> u64 {
+        self.lines.bytes
+    }
+
+    /// Samples delivered so far.
+    pub fn samples_read(&self) -> u64 {
+        self.sample
+    }
+
+    /// Fill `chunk` (cleared first, capacity kept) with up to `max_rows` rows; returns the
+    /// number of rows, 0 at the end of the data.
+    pub fn read_chunk(&mut self, chunk: &mut Chunk, max_rows: usize) -> Result<usize> {
+        chunk.first_sample = self.sample;
+        chunk.time_s.clear();
+        chunk.values.resize_with(self.info.channels.len(), Vec::new);
+        for v in &mut chunk.values {
+            v.clear();
+        }
+        if self.finished {
+            return Ok(0);
+        }
+        let mut buf = std::mem::take(&mut self.buf);
+        let mut rows = 0;
+        let result = loop {
+            if rows == max_rows {
+                break Ok(());
+            }
+            let line = match self.lines.next(&mut buf) {
+                Ok(Some(n)) => n,
+                Ok(None) => {
+                    self.finish();
+                    break Ok(());
+                }
+                Err(e) => break Err(e),
+            };
+            if trim_field(&buf).is_empty() {
+                continue;
+            }
+            if let Err(e) = self.parse_row(line, &buf, chunk) {
+                break Err(e);
+            }
+            rows += 1;
+        };
+        self.buf = buf;
+        if result.is_err() {
+            self.finished = true;
+        }
+        result.map(|()| rows)
+    }
+
+    /// Next chunk of the configured size (`ReadOptions::chunk_rows`), `None` at the end.
+    pub fn next_chunk(&mut self) -> Result<Option<Chunk>> {
+        let mut c = Chunk::default();
+        let n = self.read_chunk(&mut c, self.chunk_rows)?;
+        Ok((n > 0).then_some(c))
+    }
+
+    fn finish(&mut self) {
+        self.finished = true;
+        if let Some(n) = self.info.expected_samples {
+            if n != self.sample {
+                self.warnings.push(format!(
+                    "{}: the header announces {n} samples per channel, the file has {}",
+                    self.info.file, self.sample
+                ));
+            }
+        }
+    }
+
+    /// Parse one data row into `chunk` (hot loop).
+    fn parse_row(&mut self, line: u64, row: &[u8], chunk: &mut Chunk) -> Result<()> {
+        let delim = self.info.delimiter as u8;
+        let dc = self.info.decimal_comma;
+        let mut n_fields = 0;
+        let mut time = None;
+        let mut failure = None;
+        for (j, f) in fields(row, delim).enumerate() {
+            n_fields = j + 1;
+            match self.slots.get(j) {
+                Some(Slot::Skip) => {}
+                Some(&Slot::Channel(k)) => match parse_number(f, dc) {
+                    Some(v) => {
+                        chunk.values[k].push(v);
+                    }
+                    None => {
+                        failure = Some(self.cell_error(line, row, j, f));
+                        break;
+                    }
+                },
+                Some(Slot::Time) => match parse_number(f, dc) {
+                    Some(v) => time = Some(v * self.time_scale),
+                    None => {
+                        failure = Some(self.cell_error(line, row, j, f));
+                        break;
+                    }
+                },
+                None if trim_field(f).is_empty() => {}
+                None => {
+                    failure = Some(self.field_count_error(line, row));
+                    break;
+                }
+            }
+        }
+        if failure.is_none() && n_fields < self.slots.len() {
+            failure = Some(self.field_count_error(line, row));
+        }
+        if failure.is_none() {
+            failure = self.check_time(line, time, chunk).err();
+        }
+        if let Some(e) = failure {
+            let len = chunk.time_s.len();
+            for v in &mut chunk.values {
+                v.truncate(len);
+            }
+            return Err(e);
+        }
+        self.sample += 1;
+        Ok(())
+    }
+
+    /// Check the time cell (if any) and push the sample time.
+    fn check_time(&mut self, line: u64, time: Option<f64>, chunk: &mut Chunk) -> Result<()> {
+        let fs = self.info.sample_rate_hz;
+        let expected = self.info.start_time_s + self.sample as f64 / fs;
+        let Some(t) = time else {
+            chunk.time_s.push(expected);
+            return Ok(());
+        };
+        if t <= self.previous_time {
+            return Err(RecordingError::TimeNotMonotonic {
+                file: self.info.file.clone(),
+                line,
+                column: self.time_column,
+                time_s: t,
+                previous_s: self.previous_time,
+            });
+        }
+        if (t - expected).abs() > 0.5 / fs {
+            return Err(RecordingError::RateInconsistent {
+                file: self.info.file.clone(),
+                line,
+                column: self.time_column,
+                time_s: t,
+                sample: self.sample,
+                rate_hz: fs,
+                rate_source: self.info.sample_rate_source.clone(),
+                start_s: self.info.start_time_s,
+                expected_s: expected,
+            });
+        }
+        self.previous_time = t;
+        chunk.time_s.push(t);
+        Ok(())
+    }
+
+    fn cell_error(&self, line: u64, row: &[u8], j: usize, cell: &[u8]) -> RecordingError {
+        if let Some(detail) = binary_issue(row) {
+            return RecordingError::Binary {
+                file: self.info.file.clone(),
+                line,
+                detail,
+            };
+        }
+        let mut text = decode(trim_field(cell));
+        if text.chars().count() > 40 {
+            text = text.chars().take(40).collect::<String>() + "…";
+        }
+        RecordingError::NotNumeric {
+            file: self.info.file.clone(),
+            line,
+            column: j + 1,
+            name: self.info.columns[j].header.clone(),
+            text,
+        }
+    }
+
+    fn field_count_error(&self, line: u64, row: &[u8]) -> RecordingError {
+        if let Some(detail) = binary_issue(row) {
+            return RecordingError::Binary {
+                file: self.info.file.clone(),
+                line,
+                detail,
+            };
+        }
+        let delim = self.info.delimiter as u8;
+        let found = fields(row, delim).count();
+        let hint = if self.info.delimiter == ',' && row.contains(&b'.') {
+            String::new()
+        } else if self.info.delimiter == ',' {
+            " (decimal commas need a semicolon or tab delimiter)".to_string()
+        } else {
+            String::new()
+        };
+        RecordingError::FieldCount {
+            file: self.info.file.clone(),
+            line,
+            expected: self.slots.len(),
+            found,
+            hint,
+        }
+    }
+}
+
+/// Scale of a time column's unit to seconds.
+fn time_unit_scale(c: &Channel) -> Option<f64> {
+    match c.unit.as_deref().map(str::trim) {
+        None | Some("") | Some("s") | Some("sec") => Some(1.0),
+        Some("ms") => Some(1e-3),
+        Some("us") | Some("µs") | Some("μs") => Some(1e-6),
+        Some("min") => Some(60.0),
+        _ => None,
+    }
+}
+
+/// Find a column by its full header text or by its name without unit (exact, then
+/// case-insensitive).
+pub(crate) fn find_column(columns: &[Channel], name: &str) -> Option<usize> {
+    let n = name.trim();
+    let base = split_unit(n).0;
+    columns
+        .iter()
+        .position(|c| c.header == n)
+        .or_else(|| columns.iter().position(|c| c.name == n))
+        .or_else(|| {
+            columns
+                .iter()
+                .position(|c| c.header.eq_ignore_ascii_case(n) || c.name.eq_ignore_ascii_case(n))
+        })
+        .or_else(|| {
+            columns
+                .iter()
+                .position(|c| c.name.eq_ignore_ascii_case(&base))
+        })
+}
+
+/// The parsed header before columns are resolved.
+struct HeaderParts {
+    format: Format,
+    delimiter: u8,
+    metadata: Vec<(String, String)>,
+    names: Vec<String>,
+    units: Option<Vec<String>>,
+    names_line: u64,
+    last_line: u64,
+}
+
+impl HeaderParts {
+    /// Columns with units from the names and the unit row (the unit row wins on a clash).
+    fn columns(&self, warnings: &mut Vec<String>) -> Vec<Channel> {
+        let mut names = self.names.clone();
+        while names.len() > 1 && names.last().is_some_and(|n| n.is_empty()) {
+            names.pop();
+        }
+        names
+            .iter()
+            .enumerate()
+            .map(|(j, h)| {
+                let header = if h.is_empty() {
+                    format!("column{}", j + 1)
+                } else {
+                    h.clone()
+                };
+                let (name, mut unit) = split_unit(&header);
+                if let Some(u) = self
+                    .units
+                    .as_ref()
+                    .and_then(|u| u.get(j))
+                    .filter(|u| !u.is_empty())
+                {
+                    if unit.as_ref().is_some_and(|h| h != u) {
+                        warnings.push(format!("column `{header}`: unit row says `{u}`, using it"));
+                    }
+                    unit = Some(u.clone());
+                }
+                Channel {
+                    name,
+                    header,
+                    unit,
+                    column: j + 1,
+                }
+            })
+            .collect()
+    }
+
+    fn meta(&self, prefix: &str) -> Option<(&str, &str)> {
+        self.metadata
+            .iter()
+            .find(|(k, _)| k.to_ascii_lowercase().starts_with(prefix))
+            .map(|(k, v)| (k.as_str(), v.as_str()))
+    }
+
+    /// `Sampling rate [Hz]` (or `[kHz]`) from DynoWare metadata.
+    fn sampling_rate(&self, decimal_comma: bool) -> Option<f64> {
+        let (k, v) = self.meta("sampling rate")?;
+        let f = meta_number(v, decimal_comma)?;
+        let scale = if k.to_ascii_lowercase().contains("khz") {
+            1e3
+        } else {
+            1.0
+        };
+        Some(f * scale).filter(|f| *f > 0.0)
+    }
+
+    fn expected_samples(&self) -> Option<u64> {
+        let (_, v) = self.meta("samples per channel")?;
+        v.trim().parse().ok()
+    }
+}
+
+/// Header of a DynoWare export; `buf` holds line 1.
+fn read_dynoware_header<R: BufRead>(
+    lines: &mut LineSource<R>,
+    buf: &mut Vec<u8>,
+    first_no: u64,
+    warnings: &mut Vec<String>,
+) -> Result<HeaderParts> {
+    let file = lines.file.clone();
+    let header_err = |line: u64, message: String| RecordingError::Header {
+        file: file.clone(),
+        line,
+        message,
+    };
+    let delimiter = match buf.get(8) {
+        Some(&d) if d == b',' || d == b';' || d == b'\t' => d,
+        _ => {
+            return Err(header_err(
+                first_no,
+                "expected `DynoWare` followed by a comma, semicolon or tab".into(),
+            ))
+        }
+    };
+    let first = decode(buf);
+    let version = first[9..]
+        .trim()
+        .trim_end_matches(delimiter as char)
+        .trim()
+        .to_string();
+    let mut metadata = Vec::new();
+    let (names_line, names) = loop {
+        let Some(n) = lines.next_nonblank(buf)? else {
+            return Err(header_err(
+                lines.line_no,
+                "DynoWare header ended before the channel-name row (e.g. `Time,Fx,Fy,Fz`)".into(),
+            ));
+        };
+        let s = decode(buf);
+        match key_line(&s, delimiter as char) {
+            Some(kv) => metadata.push(kv),
+            None => break (n, split_cells(&s, delimiter)),
+        }
+    };
+    let Some(units_line) = lines.next_nonblank(buf)? else {
+        return Err(header_err(
+            names_line + 1,
+            "DynoWare header ended before the unit row (e.g. `s,N,N,N`)".into(),
+        ));
+    };
+    let units = if is_unit_row(buf, delimiter, true) {
+        Some(split_cells(&decode(buf), delimiter))
+    } else {
+        warnings.push(format!(
+            "{file}:{units_line}: no unit row after the channel names (DynoWare normally has one)"
+        ));
+        lines.pending.push_front((units_line, std::mem::take(buf)));
+        None
+    };
+    Ok(HeaderParts {
+        format: Format::DynoWare { version },
+        delimiter,
+        metadata,
+        names,
+        last_line: if units.is_some() {
+            units_line
+        } else {
+            names_line
+        },
+        units,
+        names_line,
+    })
+}
+
+/// Header of a generic CSV/TSV; `buf` holds the header row.
+fn read_generic_header<R: BufRead>(
+    lines: &mut LineSource<R>,
+    buf: &mut Vec<u8>,
+    first_no: u64,
+) -> Result<HeaderParts> {
+    let header = std::mem::take(buf);
+    let next = lines.next_nonblank(buf)?;
+    let delimiter = detect_delimiter(&header, next.map(|_| buf.as_slice()));
+    if fields(&header, delimiter).all(|f| parse_number(f, true).is_some()) {
+        return Err(RecordingError::Header {
+            file: lines.file.clone(),
+            line: first_no,
+            message: "the first line is numeric: a header row with the channel names is required \
+                      (e.g. `time_s,fx_N,fy_N` or `Fx [N];Fy [N]`)"
+                .into(),
+        });
+    }
+    let names = split_cells(&decode(&header), delimiter);
+    let mut last_line = first_no;
+    let units = match next {
+        Some(n) if is_unit_row(buf, delimiter, true) => {
+            last_line = n;
+            Some(split_cells(&decode(buf), delimiter))
+        }
+        Some(n) => {
+            lines.pending.push_front((n, std::mem::take(buf)));
+            None
+        }
+        None => None,
+    };
+    Ok(HeaderParts {
+        format: Format::GenericCsv,
+        delimiter,
+        metadata: Vec::new(),
+        names,
+        units,
+        names_line: first_no,
+        last_line,
+    })
+}
+
+/// Split a header line into trimmed cells (quotes removed).
+fn split_cells(s: &str, delimiter: u8) -> Vec<String> {
+    s.split(delimiter as char)
+        .map(|c| c.trim().trim_matches('"').trim().to_string())
+        .collect()
+}
