@@ -23,12 +23,15 @@ struct Cli {
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
     Simulate(cmd::simulate::Args),
+    /// Identify runout (and cutting coefficients) from measured forces.
+    Identify(cmd::identify::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
+        Command::Identify(a) => cmd::identify::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -7,6 +7,7 @@
 
 pub mod config;
 pub mod export;
+pub mod peak_table;
 pub mod plot;
 pub mod recording;
 pub mod units;
