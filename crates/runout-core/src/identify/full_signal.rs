@@ -109,10 +109,11 @@ pub enum RunoutObservability {
 /// Check the runout columns of the Jacobian at the start point; when one direction is
 /// unobservable (singular-value ratio < 1e-4), restrict the fit to the observable one.
 fn runout_observability(p: &mut Problem<'_>) -> RunoutObservability {
-    p.recompute();
     p.analytic = true;
+    p.recompute();
     let jac = p.jacobian();
     p.analytic = false;
+    p.recompute();
     let Some(j) = jac else {
         return RunoutObservability::Full;
     };
@@ -225,10 +226,16 @@ impl Problem<'_> {
             1.0
         }
     }
+    /// Model sums at the current parameters (with the analytic runout derivatives only when
+    /// `analytic` is set — the solver's Jacobian uses differences).
     fn recompute(&mut self) {
         let (e, t) = self.runout();
         let tilt = self.fit_tilt;
-        self.sums = self.models.iter().map(|m| m.sums(e, t, tilt)).collect();
+        self.sums = if self.analytic {
+            self.models.iter().map(|m| m.sums(e, t, tilt)).collect()
+        } else {
+            self.models.iter().map(|m| m.base_sums(e, t)).collect()
+        };
     }
     fn n_residuals(&self) -> usize {
         self.cases
@@ -281,26 +288,26 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
         let nr = self.n_runout();
         let np = self.x.len();
         let mut j = DMatrix::zeros(self.n_residuals(), np);
-        // Runout columns by central differences over ±RUNOUT_STEP_UM (see the constant), or
+        // Runout columns by forward differences over RUNOUT_STEP_UM (see the constant), or
         // analytic (smooth part only) for the covariance.
         let kc = self.coefficients();
+        let here = if self.analytic {
+            Vec::new()
+        } else {
+            self.raw_residuals()
+        };
         let fd: Vec<DVector<f64>> = (0..nr)
             .map(|p| {
                 if self.analytic {
                     return self.analytic_runout_column(p, &kc);
                 }
                 let mut plus = self.clone();
-                let mut minus = self.clone();
                 plus.x[p] += RUNOUT_STEP_UM;
-                minus.x[p] -= RUNOUT_STEP_UM;
                 plus.recompute();
-                minus.recompute();
-                let (fp, fm) = (plus.raw_residuals(), minus.raw_residuals());
+                let fp = plus.raw_residuals();
                 DVector::from_iterator(
                     fp.len(),
-                    fp.iter()
-                        .zip(&fm)
-                        .map(|(a, b)| (a - b) / (2.0 * RUNOUT_STEP_UM)),
+                    fp.iter().zip(&here).map(|(a, b)| (a - b) / RUNOUT_STEP_UM),
                 )
             })
             .collect();
@@ -353,30 +360,38 @@ impl Problem<'_> {
 fn linear_coefficients(p: &mut Problem<'_>) -> Result<(), IdentifyError> {
     let nr = p.n_runout();
     let ncoef = p.coef_idx.len();
-    for v in p.x.iter_mut().skip(nr) {
-        *v = 0.0;
-    }
     p.recompute();
-    let jac = p.jacobian().expect("jacobian");
-    let x = jac.columns(nr, ncoef).into_owned();
-    // residuals at zero coefficients = −measured/w
-    let y = -p
-        .residuals()
-        .ok_or_else(|| IdentifyError::singular("full-signal fit", "non-finite data"))?;
+    // weighted design (the sums do not depend on the coefficients) and measured values
+    let n = p.n_residuals();
+    let mut x = DMatrix::zeros(n, ncoef);
+    let mut y = DVector::zeros(n);
+    let mut row = 0;
+    for (c, case) in p.cases.iter().enumerate() {
+        for (k, comp) in case.waveform.components.iter().enumerate() {
+            for (q, v) in comp.values.iter().enumerate() {
+                let w = p.weight(c, k, q);
+                let g = coefficient_gradient(comp.axis, &p.sums[c].base[q]);
+                for (j, &i) in p.coef_idx.iter().enumerate() {
+                    x[(row, j)] = g[i] / w;
+                }
+                y[row] = v / w;
+                row += 1;
+            }
+        }
+    }
     let fit = linear_lsq("coefficient start values", &x, &y)?;
     for c in 0..ncoef {
         p.x[nr + c] = fit.beta[c];
     }
-    p.recompute();
     Ok(())
 }
 
-/// Step (µm, or µm/mm for tilt) of the central differences for the runout columns of the
+/// Step (µm, or µm/mm for tilt) of the forward differences for the runout columns of the
 /// Jacobian. The analytic derivative ([`RevolutionModel::sums`]) misses the edge-force switch at
 /// h = 0: where a tooth's chip vanishes inside the engagement (edge skipping, up-milling entry)
 /// moving the runout moves that boundary, and with many axial disks the sum of the small steps is
 /// a real slope. Ignoring it stalled LM 1.9 µm from the optimum (K = 2, ρ = 27 µm); a 0.1 µm
-/// central difference spans enough steps to see the macroscopic slope.
+/// difference spans enough steps to see the macroscopic slope.
 const RUNOUT_STEP_UM: f64 = 0.1;
 
 const NAMES: [&str; 6] = ["ktc", "krc", "kac", "kte", "kre", "kae"];
@@ -434,8 +449,8 @@ pub fn full_signal_fit(
         ));
     }
     // Start values: the frequency-domain estimate (§4.7) and the caller's guess, then a coarse
-    // scan of the runout vector (12 angles × 3 offsets around the estimate) with the exactly
-    // solved coefficients at each point; LM runs from the best two — with edge skipping (large ρ,
+    // scan of the runout vector (16 angles × 3 offsets around the estimate) with the exactly
+    // solved coefficients at each point; LM runs from the best (and from the second best when its cost is within 2×) — with edge skipping (large ρ,
     // K = 2) the cost has local minima the frequency estimate alone can fall into.
     linear_coefficients(&mut problem)?;
     let mut initial = None;
@@ -461,9 +476,9 @@ pub fn full_signal_fit(
         .iter()
         .map(|e| e[0].hypot(e[1]))
         .fold(0.002, f64::max);
-    for scale in [0.5, 0.75, 1.0, 1.25, 1.5] {
-        for a in 0..24 {
-            let (s, c) = (a as f64 * std::f64::consts::TAU / 24.0).sin_cos();
+    for scale in [0.5, 1.0, 1.5] {
+        for a in 0..16 {
+            let (s, c) = (a as f64 * std::f64::consts::TAU / 16.0).sin_cos();
             candidates.push([r0 * scale * c, r0 * scale * s]);
         }
     }
@@ -479,7 +494,9 @@ pub fn full_signal_fit(
     }
     scored.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut best: Option<(Problem<'_>, levenberg_marquardt::MinimizationReport<f64>)> = None;
-    for (_, x) in scored.iter().take(2) {
+    // second start only when its scan cost is comparable (within 2×) to the best one's
+    let best_cost = scored.first().map(|c| c.0).unwrap_or(f64::INFINITY);
+    for (_, x) in scored.iter().take(2).filter(|c| c.0 <= 2.0 * best_cost) {
         let mut start = problem.clone();
         start.set_params(x);
         let (done, report) = LevenbergMarquardt::new().with_patience(200).minimize(start);
@@ -492,11 +509,11 @@ pub fn full_signal_fit(
     }
     let (mut problem, report) =
         best.ok_or_else(|| IdentifyError::singular("full-signal fit", "no valid start value"))?;
-    problem.recompute();
-    // Covariance from the analytic (smooth) runout derivatives: the central differences also
-    // catch the edge-force steps, which carry no statistical information per sample and would
-    // inflate JᵀJ (standard errors 5× too small in the round-trip tests).
+    // Covariance from the analytic (smooth) runout derivatives: the differences also catch the
+    // edge-force steps, which carry no statistical information per sample and would inflate JᵀJ
+    // (standard errors 5× too small in the round-trip tests).
     problem.analytic = true;
+    problem.recompute();
     let jac = problem
         .jacobian()
         .ok_or_else(|| IdentifyError::singular("full-signal fit", "Jacobian"))?;

@@ -19,6 +19,7 @@ use crate::angle::wrap_tau;
 use crate::coefficients::CuttingCoefficients;
 use crate::cut::Cut;
 use crate::cutter::Cutter;
+use rayon::prelude::*;
 use std::f64::consts::TAU;
 
 /// Per (disk, tooth) geometry.
@@ -112,8 +113,17 @@ impl RevolutionModel {
     /// Basis sums for runout offset `e` (mm) and tilt `tau` (mm/mm); `tilt_derivs` adds the
     /// τ derivatives.
     pub fn sums(&self, e: [f64; 2], tau: [f64; 2], tilt_derivs: bool) -> BasisSums {
+        self.compute(e, tau, if tilt_derivs { 4 } else { 2 })
+    }
+
+    /// Basis sums only (no derivatives): `deriv` is empty per sample.
+    pub fn base_sums(&self, e: [f64; 2], tau: [f64; 2]) -> BasisSums {
+        self.compute(e, tau, 0)
+    }
+
+    /// Samples are independent: evaluated in parallel (rayon), `np` derivatives per sample.
+    fn compute(&self, e: [f64; 2], tau: [f64; 2], np: usize) -> BasisSums {
         let k = self.k;
-        let np = if tilt_derivs { 4 } else { 2 };
         // per disk: radii, unit normals, and the per-tooth active differences are sample-independent
         let mut dr = vec![0.0; self.disks * k * k];
         let mut dn = vec![[0.0f64; 2]; self.disks * k * k];
@@ -138,22 +148,31 @@ impl RevolutionModel {
                 }
             }
         }
-        let mut base = vec![[0.0f64; 6]; self.grid.len()];
-        let mut deriv = vec![vec![[0.0f64; 3]; np]; self.grid.len()];
-        for (q, &(theta, st_t, ct_t)) in self.grid.iter().enumerate() {
-            let b = &mut base[q];
-            let d = &mut deriv[q];
-            for j in 0..self.disks {
-                let z = self.heights[j];
-                for i in 0..k {
-                    let sl = &self.slices[j * k + i];
+        // Each (disk, tooth) is in the engagement for one contiguous run of grid samples: visit
+        // only that run (plus a guard sample each side) and apply the same exact test
+        // `wrap(θ + ψ − φ_st) ≤ width` as the simulation. Disks in parallel (rayon), reduced.
+        let n = self.grid.len();
+        let dtheta = TAU / n as f64;
+        let run = ((self.width / dtheta).floor() as usize + 3).min(n);
+        let theta0 = self.grid.first().map(|g| g.0).unwrap_or(0.0);
+        let empty = || (vec![[0.0f64; 6]; n], vec![[0.0f64; 3]; n * np]);
+        let disk = |(mut b, mut d): (Vec<[f64; 6]>, Vec<[f64; 3]>), j: usize| {
+            let z = self.heights[j];
+            let dz = self.dz;
+            for i in 0..k {
+                let sl = &self.slices[j * k + i];
+                let a = wrap_tau(theta0 + sl.psi - self.st);
+                let first = ((TAU - a) / dtheta).floor() as i64 - 1;
+                let base_idx = (j * k + i) * k;
+                for t in 0..run {
+                    let q = (first + t as i64).rem_euclid(n as i64) as usize;
+                    let (theta, st_t, ct_t) = self.grid[q];
                     let rel = wrap_tau(theta + sl.psi - self.st);
                     if rel > self.width {
                         continue;
                     }
                     let s = st_t * sl.cos_psi + ct_t * sl.sin_psi;
                     let co = ct_t * sl.cos_psi - st_t * sl.sin_psi;
-                    let base_idx = (j * k + i) * k;
                     let mut h = f64::INFINITY;
                     let mut arg = 0;
                     for m in 0..k {
@@ -166,15 +185,15 @@ impl RevolutionModel {
                     if h <= 0.0 {
                         continue;
                     }
-                    let dz = self.dz;
-                    b[0] += h * co * dz;
-                    b[1] += h * s * dz;
-                    b[2] += co * dz;
-                    b[3] += s * dz;
-                    b[4] += h * dz;
-                    b[5] += dz;
+                    let bq = &mut b[q];
+                    bq[0] += h * co * dz;
+                    bq[1] += h * s * dz;
+                    bq[2] += co * dz;
+                    bq[3] += s * dz;
+                    bq[4] += h * dz;
+                    bq[5] += dz;
                     let g = dn[base_idx + arg];
-                    for (p, dp) in d.iter_mut().enumerate() {
+                    for (p, dp) in d[q * np..(q + 1) * np].iter_mut().enumerate() {
                         let gh = match p {
                             0 => g[0],
                             1 => g[1],
@@ -187,7 +206,31 @@ impl RevolutionModel {
                     }
                 }
             }
-        }
+            (b, d)
+        };
+        let add = |(mut b1, mut d1): (Vec<[f64; 6]>, Vec<[f64; 3]>),
+                   (b2, d2): (Vec<[f64; 6]>, Vec<[f64; 3]>)| {
+            for (x, y) in b1.iter_mut().zip(&b2) {
+                for r in 0..6 {
+                    x[r] += y[r];
+                }
+            }
+            for (x, y) in d1.iter_mut().zip(&d2) {
+                for r in 0..3 {
+                    x[r] += y[r];
+                }
+            }
+            (b1, d1)
+        };
+        let (base, flat) = if self.disks >= 8 {
+            (0..self.disks)
+                .into_par_iter()
+                .fold(empty, disk)
+                .reduce(empty, add)
+        } else {
+            (0..self.disks).fold(empty(), disk)
+        };
+        let deriv = (0..n).map(|q| flat[q * np..(q + 1) * np].to_vec()).collect();
         BasisSums { base, deriv }
     }
 }
