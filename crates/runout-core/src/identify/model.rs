@@ -46,6 +46,10 @@ pub struct RevolutionModel {
     width: f64,
     /// (θ, sin θ, cos θ) per grid sample.
     grid: Vec<(f64, f64, f64)>,
+    /// Apply the edge forces over the whole engagement window instead of only where h > 0
+    /// (default false = as the simulation). The window-gated variant is continuous in the
+    /// runout; the full-signal fit uses it for its first stage (see `full_signal`).
+    pub edge_in_window: bool,
 }
 
 /// Per-sample basis sums and runout derivatives (see module docs).
@@ -102,6 +106,7 @@ impl RevolutionModel {
             st,
             width: ex - st,
             grid,
+            edge_in_window: false,
         }
     }
 
@@ -183,6 +188,12 @@ impl RevolutionModel {
                         }
                     }
                     if h <= 0.0 {
+                        if self.edge_in_window {
+                            let bq = &mut b[q];
+                            bq[2] += co * dz;
+                            bq[3] += s * dz;
+                            bq[5] += dz;
+                        }
                         continue;
                     }
                     let bq = &mut b[q];
@@ -230,7 +241,9 @@ impl RevolutionModel {
         } else {
             (0..self.disks).fold(empty(), disk)
         };
-        let deriv = (0..n).map(|q| flat[q * np..(q + 1) * np].to_vec()).collect();
+        let deriv = (0..n)
+            .map(|q| flat[q * np..(q + 1) * np].to_vec())
+            .collect();
         BasisSums { base, deriv }
     }
 }
