@@ -377,3 +377,58 @@ fn two_teeth_helical_accuracy() {
         assert!(angle_diff_deg(fit.angle.value.to_degrees(), s.lambda_deg) < 3.0);
     }
 }
+
+#[test]
+fn tilt_round_trip() {
+    // offset 6 µm at 40° plus tilt 2 µm/mm at −60° over a_p 4 mm (helix 30°, K 4, down a_e 3):
+    // fitted with the tilt vector; both recovered (offset within 0.3 µm, tilt within 0.2 µm/mm).
+    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let runout = Runout::new(0.006, 40f64.to_radians())
+        .unwrap()
+        .with_tilt(0.002, -60f64.to_radians())
+        .unwrap();
+    let cut = Cut::new(3000.0, 0.08, 4.0)
+        .unwrap()
+        .radial(3.0, MillingMode::Down, &cutter)
+        .unwrap();
+    let model = ForceModel {
+        cutter: cutter.clone(),
+        runout,
+        cut,
+        coefficients: kc(),
+    };
+    let chip = ArcChip::new(&cutter, &runout, 0.08).unwrap();
+    let s = model.simulate(&chip, &Sampling::new(20.0, 1.0, 530).unwrap());
+    let mut rng = StdRng::seed_from_u64(5);
+    let mut noisy = |v: &[f64]| -> Vec<f64> {
+        let sd = 0.02 * v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let n = Normal::new(0.0, sd).unwrap();
+        v.iter().map(|x| x + n.sample(&mut rng)).collect()
+    };
+    let (x, y, z) = (noisy(&s.fx), noisy(&s.fy), noisy(&s.fz));
+    let waveform =
+        AveragedWaveform::average(0.0, 360, &[(Axis::X, &x), (Axis::Y, &y), (Axis::Z, &z)])
+            .unwrap();
+    let fit = full_signal_fit(
+        &[WaveformCase {
+            cutter,
+            cut,
+            waveform,
+        }],
+        &FullSignalOptions {
+            fit_tilt: true,
+            ..FullSignalOptions::default()
+        },
+    )
+    .unwrap();
+    let t = fit.tilt.unwrap();
+    let (tx, ty) = (t[0].value * 1e3, t[1].value * 1e3);
+    let (ex, ey) = (
+        2.0 * (-60f64).to_radians().cos(),
+        2.0 * (-60f64).to_radians().sin(),
+    );
+    println!("tilt ({tx:.3}, {ty:.3}) ± {:.3} µm/mm vs ({ex:.3}, {ey:.3}); ρ {:.3} ± {:.3} µm λ {:.2} ± {:.2}°; cond {:.1}; {:?}", t[0].se.unwrap() * 1e3, fit.offset.value * 1e3, fit.offset.se.unwrap() * 1e3, fit.angle.value.to_degrees(), fit.angle.se.unwrap().to_degrees(), fit.condition, fit.warnings);
+    assert!((tx - ex).abs() < 0.2 && (ty - ey).abs() < 0.2);
+    assert!((fit.offset.value * 1e3 - 6.0).abs() < 0.3);
+    assert!(angle_diff_deg(fit.angle.value.to_degrees(), 40.0) < 3.0);
+}

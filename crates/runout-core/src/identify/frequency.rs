@@ -86,7 +86,17 @@ pub fn frequency_estimate(
     }
     let x = DMatrix::from_fn(rows.len(), 2, |r, c| rows[r][c]);
     let y = DVector::from_vec(rhs);
-    let fit = linear_lsq("frequency-domain runout estimate", &x, &y)?;
+    let fit = linear_lsq("frequency-domain runout estimate", &x, &y).map_err(|e| match e {
+        IdentifyError::Singular { what, reason } => IdentifyError::Singular {
+            what,
+            reason: format!(
+                "{reason}: one direction of the runout vector does not change the spindle \
+                 harmonic (K = 2 with straight flutes: only the component along the tooth line \
+                 is observable)"
+            ),
+        },
+        other => other,
+    })?;
     let e = [fit.beta[0], fit.beta[1]];
     Ok(FrequencyEstimate {
         vector: e,

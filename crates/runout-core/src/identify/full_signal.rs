@@ -10,10 +10,17 @@
 //! recordings (e.g. different feeds) share all unknowns.
 //!
 //! Residuals r = (model − measured)/w with w the per-sample standard error when every component
-//! carries one, else w = 1 N. Solver: Levenberg–Marquardt (`levenberg-marquardt` crate) with the
-//! analytic Jacobian. Start: runout from the frequency-domain estimate (§4.7,
-//! [`frequency_estimate`]) or the caller's guess (e.g. the sine fit), coefficients from the exact
-//! linear least squares at that runout (the forces are linear in the coefficients).
+//! carries one, else w = 1 N. Solution in two stages:
+//! 1. on the *smooth* variant of the model (edge forces over the whole engagement window, which
+//!    makes the residuals continuous in the runout): a scan of the runout vector around the
+//!    start value (frequency-domain estimate §4.7 [`frequency_estimate`], or the caller's guess,
+//!    e.g. the sine fit) with the coefficients solved exactly by linear least squares at each
+//!    point (the forces are linear in them), then Levenberg–Marquardt (`levenberg-marquardt`
+//!    crate; analytic coefficient columns, central differences over ±0.1 µm for the runout);
+//! 2. on the *exact* model (edge forces only where h > 0, as the simulation): a derivative-free
+//!    compass search of the runout parameters on the profile cost (coefficients re-solved
+//!    linearly), because the exact residuals jump by K_e·dz wherever a tooth's chip crosses zero
+//!    and a gradient method stalls on those steps.
 //!
 //! Uncertainty: Cov = s²·(JᵀJ)⁻¹ at the solution with s² = Σr²/(n − p) (the "scaled" covariance:
 //! correct when the weights are right up to a common factor), standard errors from its diagonal,
@@ -80,9 +87,9 @@ pub struct FullSignalFit {
     pub n: usize,
     /// Residual degrees of freedom.
     pub dof: usize,
-    /// Model evaluations used by the solver.
+    /// Model evaluations of the solver (stage-1 residual evaluations + stage-2 search points).
     pub evaluations: usize,
-    /// Solver termination reason.
+    /// Termination reason of the stage-1 Levenberg–Marquardt solver.
     pub termination: String,
     /// The start value from the frequency-domain estimate, when used.
     pub initial: Option<FrequencyEstimate>,
@@ -382,19 +389,22 @@ fn profile_cost(p: &mut Problem<'_>) -> f64 {
 /// max(0.5 µm, 5 % of ρ) halved down to 0.005 µm. Returns the number of model evaluations.
 fn pattern_search(p: &mut Problem<'_>) -> usize {
     let nr = p.n_runout();
-    let mut x = p.x.clone();
-    p.set_params(&x);
+    let x0 = p.x.clone();
+    p.set_params(&x0);
+    let dirs = search_directions(p);
     let mut best = profile_cost(p);
-    x = p.x.clone();
+    let mut x = p.x.clone();
     let (e, _) = p.runout();
     let mut step = (0.05 * e[0].hypot(e[1]) * 1e3).max(0.5);
     let mut evals = 1;
-    while step > 0.005 && evals < 400 {
+    while step > 0.005 && evals < 600 {
         let mut moved = false;
-        for k in 0..nr {
+        for d in &dirs {
             for sign in [1.0, -1.0] {
                 let mut trial = x.clone();
-                trial[k] += sign * step;
+                for k in 0..nr {
+                    trial[k] += sign * step * d[k];
+                }
                 p.set_params(&trial);
                 let c = profile_cost(p);
                 evals += 1;
@@ -412,6 +422,53 @@ fn pattern_search(p: &mut Problem<'_>) -> usize {
     }
     p.set_params(&x);
     evals
+}
+
+/// Search directions for [`pattern_search`]: eigenvectors of the profile Gauss–Newton matrix of
+/// the runout parameters (analytic Jacobian with the coefficient columns projected out), scaled
+/// by 1/√eigenvalue relative to the least determined one — i.e. steps in standard-error units,
+/// so that a narrow diagonal valley (offset–tilt correlation) is followed instead of stalling.
+fn search_directions(p: &mut Problem<'_>) -> Vec<Vec<f64>> {
+    let nr = p.n_runout();
+    let axes = || {
+        (0..nr)
+            .map(|k| (0..nr).map(|j| if j == k { 1.0 } else { 0.0 }).collect())
+            .collect()
+    };
+    p.analytic = true;
+    p.recompute();
+    let jac = p.jacobian();
+    p.analytic = false;
+    p.recompute();
+    let Some(j) = jac else { return axes() };
+    let np = j.ncols();
+    let jr = j.columns(0, nr).into_owned();
+    let jc = j.columns(nr, np - nr).into_owned();
+    // residual of J_r after projecting on span(J_c): J_r − J_c (J_cᵀJ_c)⁻¹ J_cᵀ J_r
+    let Some(inv) = (jc.transpose() * &jc).try_inverse() else {
+        return axes();
+    };
+    let proj = &jr - &jc * (inv * (jc.transpose() * &jr));
+    let h = proj.transpose() * proj;
+    let eig = nalgebra::SymmetricEigen::new(h);
+    let lmin = eig
+        .eigenvalues
+        .iter()
+        .cloned()
+        .fold(f64::INFINITY, f64::min);
+    if lmin.is_nan() || lmin <= 0.0 {
+        return axes();
+    }
+    (0..nr)
+        .map(|k| {
+            let scale = (lmin / eig.eigenvalues[k]).sqrt();
+            eig.eigenvectors
+                .column(k)
+                .iter()
+                .map(|v| v * scale)
+                .collect()
+        })
+        .collect()
 }
 
 /// Linear least squares of the coefficients at the problem's current runout.
