@@ -26,6 +26,8 @@ enum Command {
     Simulate(cmd::simulate::Args),
     /// Tool grinding: compensate the bar clamping error (probe grid → wheel path / NC program).
     Grind(cmd::grind::Args),
+    /// Identify runout (and cutting coefficients) from measured forces.
+    Identify(cmd::identify::Args),
 }
 
 fn main() -> ExitCode {
@@ -33,6 +35,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Grind(a) => cmd::grind::run(a),
+        Command::Identify(a) => cmd::identify::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

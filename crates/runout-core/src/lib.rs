@@ -26,6 +26,7 @@ pub mod cutter;
 pub mod error;
 pub mod force;
 pub mod grind;
+pub mod identify;
 pub mod runout;
 pub mod signal;
 
