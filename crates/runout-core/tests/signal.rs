@@ -302,10 +302,6 @@ fn synthetic_round_trip_with_estimated_spindle_angle() {
         sp.warning().is_none(),
         "1 % deviation is below the 2 % warning limit"
     );
-    println!(
-        "warnings {:?}, below {:?}",
-        a.warnings, a.scan.tooth_passing.strongest_below
-    );
 
     // Section within one nominal revolution of the true steady part.
     let sec = &a.scan.section;
@@ -816,7 +812,7 @@ fn noise_air_cut_and_broken_pulse_are_errors() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(48))]
+    #![proptest_config(ProptestConfig { cases: 48, failure_persistence: None, ..ProptestConfig::default() })]
     /// Random recordings and settings never panic: either a result with finite numbers or an error.
     #[test]
     fn random_input_never_panics(
