@@ -1,8 +1,8 @@
 //! Pass 3 over the section: synchronous average per revolution and per-tooth peaks.
 //!
-//! Each complete revolution of the section (between two revolution marks: t₀ + r/f for the
-//! estimated angle, rising edges for a pulse channel, piecewise linear between the N edges of an
-//! encoder) is resampled at M uniform spindle-angle bins θ_j = θ_origin + 2πj/M by linear
+//! Each complete revolution of the section (between two revolution marks: θ(t) = 2πr with
+//! θ(t) = 2π·f·(t − t₀) + w(t) − w(0) for the estimated angle (w the tracked wander), rising edges
+//! for a pulse channel, piecewise linear between the N edges of an encoder) is resampled at M uniform spindle-angle bins θ_j = θ_origin + 2πj/M by linear
 //! interpolation between the neighbouring samples. Per bin and component (F_x, F_y, F_z, |F_xy|,
 //! |F_xy| computed from the interpolated F_x, F_y) the mean, the revolution-to-revolution
 //! standard deviation and the standard error sd/√n are accumulated (shifted sums).
@@ -45,7 +45,8 @@ pub enum AngleReference {
     Absolute,
     /// θ = 0 at the pulse edge that starts each revolution.
     PulseEdge,
-    /// θ = 0 at the section start `t_ref_s`, advancing at the measured speed.
+    /// θ = 0 at the section start `t_ref_s`, advancing at the measured speed and following the
+    /// tracked wander (`SpindleSpeed::angle_wander`).
     SectionStart {
         /// Section start (s).
         t_ref_s: f64,
@@ -155,6 +156,7 @@ enum Marks {
         period: f64,
         next: u64,
         last: u64,
+        wander: Vec<(f64, f64)>,
     },
     Pulse {
         det: EdgeDetector,
@@ -221,6 +223,7 @@ impl SyncAverager {
                     period,
                     next: 0,
                     last: ((to - from) / period + 1e-9).floor() as u64,
+                    wander: speed.angle_wander.clone(),
                 },
                 1,
                 0.0,
@@ -275,15 +278,18 @@ impl SyncAverager {
         let len = (self.stop + 1).saturating_sub(start).min(c.len() as u64) as usize;
         let mut i = 0;
         while i < len {
-            if let Marks::Linear {
-                t_ref,
-                period,
-                next,
-                last,
-            } = self.marks
-            {
+            let linear = match &self.marks {
+                Marks::Linear {
+                    t_ref,
+                    period,
+                    next,
+                    last,
+                    wander,
+                } => Some((*next <= *last).then(|| mark_time(*t_ref, *period, *next, wander))),
+                Marks::Pulse { .. } => None,
+            };
+            if let Some(te) = linear {
                 // append up to and including the first sample after the next mark, in bulk
-                let te = (next <= last).then_some(t_ref + next as f64 * period);
                 let ne = te.map_or(u64::MAX, |te| (te * self.fs).floor() as u64 + 1);
                 let seg_end = (ne.saturating_sub(start).saturating_add(1)).min(len as u64) as usize;
                 let seg_end = seg_end.max(i + 1);
@@ -479,6 +485,22 @@ impl SyncAverager {
             tooth_peaks,
         })
     }
+}
+
+/// Time of revolution mark r: θ(t) = 2π·(t − t₀)/P + w(t − t₀) − w(0) = 2π·r, solved by
+/// fixed-point iteration (w changes by ≪ 1 rad per revolution, so three steps are exact to
+/// rounding).
+fn mark_time(t_ref: f64, period: f64, r: u64, wander: &[(f64, f64)]) -> f64 {
+    let mut t = t_ref + r as f64 * period;
+    if wander.is_empty() {
+        return t;
+    }
+    let w0 = super::tracker::wander_at(wander, 0.0);
+    for _ in 0..3 {
+        let w = super::tracker::wander_at(wander, t - t_ref) - w0;
+        t = t_ref + (r as f64 - w / TAU) * period;
+    }
+    t
 }
 
 /// b₀ half a tooth period before the maximum of the K-th harmonic of `wave`, reduced to the

@@ -12,13 +12,15 @@
 //! 1. [`SpindleScan`] — Welch spectrum of F_x, F_y → coarse tooth-passing line and the consistency
 //!    check against K and rpm; per-revolution envelope → steady section; pulse-channel range.
 //! 2. [`PhaseTracker`] — over the section: phase of the tooth-passing harmonic per revolution
-//!    regressed on time (or pulse-edge timing) → spindle speed ± standard error.
+//!    regressed on time (or pulse-edge timing) → spindle speed ± standard error, and the
+//!    spindle-angle wander about constant speed (≤ [`MAX_KNOTS`] knots) that pass 3 follows.
 //! 3. [`SyncAverager`] — over the section: every revolution resampled on a uniform angle grid and
 //!    averaged (mean, sd, se per bin), per-tooth peaks with revolution-to-revolution scatter.
 //!
 //! Memory per pass is independent of the recording length: pass 1 ≤ 2·L + 4·L + 2·L + 1 f64 for the
-//! spectrum (frame L ≤ 2¹⁶) + 2¹⁵ envelope blocks × 7 numbers; pass 2 O(1); pass 3 one revolution
-//! of samples × 3 + 4·M running statistics (M bins) + K. [`analyse_replay`] runs the three passes
+//! spectrum (frame L ≤ 2¹⁶) + 2¹⁵ envelope blocks × 7 numbers; pass 2 ≤ 4096 phase knots × 2;
+//! pass 3 one revolution of samples × 3 (an encoder: its N + 1 edge times) + 4·M bin statistics
+//! × 3 numbers (M bins) + K. [`analyse_replay`] runs the three passes
 //! over a replayable source; [`analyse`] over samples in memory.
 //!
 //! ```
@@ -64,7 +66,7 @@ pub use scan::{ScanResult, SpindleScan};
 pub use spectrum::ToothPassingLine;
 pub use stats::RunningStats;
 pub use steady::{SteadySection, MAX_BLOCKS};
-pub use tracker::{PhaseTracker, SpeedMethod, SpindleSpeed};
+pub use tracker::{PhaseTracker, SpeedMethod, SpindleSpeed, MAX_KNOTS};
 
 /// Everything the pipeline found (serialisable; angles in rad, forces in N, times in s: the CLI
 /// converts angles to degrees).

@@ -13,6 +13,11 @@
 //! spectral bin, far better). With fewer than 3 blocks the coarse estimate is returned with
 //! se = resolution/(K·√12).
 //!
+//! A real spindle's speed wanders (regulation, load): over minutes a constant-speed angle would
+//! drift by many degrees. The block phases are therefore also kept as knots (≤ [`MAX_KNOTS`],
+//! averaged in groups when more), and their deviation from the straight line, divided by K, is
+//! the spindle-angle wander w(t) that the synchronous average follows.
+//!
 //! **With a pulse channel**: rising edges in the section, edge time regressed on edge number
 //! (slope = period per edge, f = 1/(N·slope), se by the delta method); the revolution-to-
 //! revolution period scatter is reported as the speed variation.
@@ -63,6 +68,15 @@ pub struct SpindleSpeed {
     pub residual_unit: &'static str,
     /// Revolution-to-revolution relative scatter of the period (pulse method only).
     pub speed_variation: Option<f64>,
+    /// Phase tracking: spindle-angle wander w(t) = (φ(t) − φ_lin(t))/K (rad) at knots t (s from the
+    /// section start), φ the tracked tooth-passing phase and φ_lin its straight-line fit; the
+    /// synchronous average follows θ(t) = 2π·f·(t − t₀) + w(t) − w(0). At most
+    /// [`MAX_KNOTS`] knots. Empty for the pulse and spectrum methods.
+    #[serde(skip)]
+    pub angle_wander: Vec<(f64, f64)>,
+    /// Largest |w| (rad): how far the spindle angle strays from constant speed.
+    #[serde(rename = "angle_wander_max_rad")]
+    pub angle_wander_max: f64,
 }
 
 impl SpindleSpeed {
@@ -104,6 +118,12 @@ impl LineFit {
         self.sxy += x * y;
         self.syy += y * y;
     }
+    /// Value of the fitted line at x.
+    fn at(&self, x: f64) -> f64 {
+        let n = self.n;
+        let b = (self.sxy - self.sx * self.sy / n) / (self.sxx - self.sx * self.sx / n);
+        (self.sy - b * self.sx) / n + b * x
+    }
     /// (slope, se of slope, residual rms); needs n ≥ 3.
     fn solve(&self) -> (f64, f64, f64) {
         let n = self.n;
@@ -131,6 +151,7 @@ enum Mode {
         count: u64,
         last_phase: Option<f64>,
         fit: LineFit,
+        knots: Knots,
     },
     Pulse {
         det: EdgeDetector,
@@ -186,6 +207,7 @@ impl PhaseTracker {
                     count: 0,
                     last_phase: None,
                     fit: LineFit::default(),
+                    knots: Knots::default(),
                 }
             }
         };
@@ -220,6 +242,7 @@ impl PhaseTracker {
                 count,
                 last_phase,
                 fit,
+                knots,
             } => {
                 let dt = 1.0 / fs;
                 for i in 0..c.len() {
@@ -232,7 +255,7 @@ impl PhaseTracker {
                         break;
                     }
                     if *block != Some(b) {
-                        close_block(*acc, *tsum, *count, last_phase, fit);
+                        close_block(*acc, *tsum, *count, last_phase, fit, knots);
                         *block = Some(b);
                         *acc = (0.0, 0.0);
                         *tsum = 0.0;
@@ -283,6 +306,7 @@ impl PhaseTracker {
         let k = self.cfg.teeth as f64;
         let nominal = self.cfg.nominal_rpm;
         let coarse_rpm = 60.0 * self.coarse_hz;
+        let mut wander = Vec::new();
         let (method, hz, se, points, rms, var) = match &mut self.mode {
             Mode::Phase {
                 f_tp,
@@ -291,11 +315,17 @@ impl PhaseTracker {
                 count,
                 last_phase,
                 fit,
+                knots,
                 ..
             } => {
-                close_block(*acc, *tsum, *count, last_phase, fit);
+                close_block(*acc, *tsum, *count, last_phase, fit, knots);
+                let k_points = knots.finish();
                 if fit.n >= 3.0 {
                     let (slope, se, rms) = fit.solve();
+                    wander = k_points
+                        .iter()
+                        .map(|&(t, phi)| (t, (phi - fit.at(t)) / k))
+                        .collect();
                     let f = (*f_tp + slope / TAU) / k;
                     (
                         SpeedMethod::PhaseTracking,
@@ -373,12 +403,21 @@ impl PhaseTracker {
                 "rad"
             },
             speed_variation: var,
+            angle_wander_max: wander.iter().map(|w| w.1.abs()).fold(0.0, f64::max),
+            angle_wander: wander,
         })
     }
 }
 
 /// Close a phase-tracking block: unwrap its phase against the previous one and add the point.
-fn close_block(acc: (f64, f64), tsum: f64, count: u64, last: &mut Option<f64>, fit: &mut LineFit) {
+fn close_block(
+    acc: (f64, f64),
+    tsum: f64,
+    count: u64,
+    last: &mut Option<f64>,
+    fit: &mut LineFit,
+    knots: &mut Knots,
+) {
     if count == 0 || (acc.0 == 0.0 && acc.1 == 0.0) {
         return;
     }
@@ -388,5 +427,65 @@ fn close_block(acc: (f64, f64), tsum: f64, count: u64, last: &mut Option<f64>, f
         Some(p) => p + crate::angle::wrap_pi(raw - p),
     };
     *last = Some(phase);
-    fit.push(tsum / count as f64, phase);
+    let t = tsum / count as f64;
+    fit.push(t, phase);
+    knots.push(t, phase);
+}
+
+/// Largest number of phase knots kept.
+pub const MAX_KNOTS: usize = 4096;
+
+/// The unwrapped block phases (t, φ), averaged in groups so that at most [`MAX_KNOTS`] are kept:
+/// when full, neighbours are merged in pairs and the group size doubles (bounded memory; the
+/// phase curve is then known at a coarser time resolution).
+#[derive(Debug, Clone, Default)]
+struct Knots {
+    group: usize,
+    pending: (f64, f64, usize),
+    points: Vec<(f64, f64)>,
+}
+
+impl Knots {
+    fn push(&mut self, t: f64, phi: f64) {
+        self.group = self.group.max(1);
+        let p = &mut self.pending;
+        p.0 += t;
+        p.1 += phi;
+        p.2 += 1;
+        if p.2 == self.group {
+            self.points.push((p.0 / p.2 as f64, p.1 / p.2 as f64));
+            self.pending = (0.0, 0.0, 0);
+            if self.points.len() == MAX_KNOTS {
+                self.points = self
+                    .points
+                    .chunks(2)
+                    .map(|c| (0.5 * (c[0].0 + c[1].0), 0.5 * (c[0].1 + c[1].1)))
+                    .collect();
+                self.group *= 2;
+            }
+        }
+    }
+    fn finish(&mut self) -> Vec<(f64, f64)> {
+        let p = self.pending;
+        if p.2 > 0 {
+            self.points.push((p.0 / p.2 as f64, p.1 / p.2 as f64));
+            self.pending = (0.0, 0.0, 0);
+        }
+        std::mem::take(&mut self.points)
+    }
+}
+
+/// Spindle-angle wander w(t) (rad) at time `t` (s from the section start): linear interpolation
+/// of the knots, extrapolated along the first/last segment beyond the ends (knots sit at block
+/// centres, half a block inside the section); 0 without knots, constant with one.
+pub(crate) fn wander_at(knots: &[(f64, f64)], t: f64) -> f64 {
+    match knots.len() {
+        0 => 0.0,
+        1 => knots[0].1,
+        n => {
+            let i = knots.partition_point(|k| k.0 <= t).clamp(1, n - 1);
+            let (a, b) = (knots[i - 1], knots[i]);
+            a.1 + (b.1 - a.1) * (t - a.0) / (b.0 - a.0)
+        }
+    }
 }
