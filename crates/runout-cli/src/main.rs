@@ -19,14 +19,15 @@ struct Cli {
     command: Command,
 }
 
-// Parsed once per run: the size difference between the argument structs is irrelevant.
-#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand, Debug)]
+#[allow(clippy::large_enum_variant)] // argument structs, parsed once
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
     Simulate(cmd::simulate::Args),
     /// Identify runout (and cutting coefficients) from measured forces.
     Identify(cmd::identify::Args),
+    /// Tool grinding: compensate the bar clamping error (probe grid → wheel path / NC program).
+    Grind(cmd::grind::Args),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +35,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Identify(a) => cmd::identify::run(a),
+        Command::Grind(a) => cmd::grind::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -25,6 +25,7 @@ pub mod cut;
 pub mod cutter;
 pub mod error;
 pub mod force;
+pub mod grind;
 pub mod identify;
 pub mod runout;
 

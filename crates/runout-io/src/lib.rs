@@ -7,6 +7,8 @@
 
 pub mod config;
 pub mod export;
+pub mod gcode;
+pub mod grind;
 pub mod peak_table;
 pub mod plot;
 pub mod recording;

@@ -1,4 +1,5 @@
 //! One module per subcommand.
 
+pub mod grind;
 pub mod identify;
 pub mod simulate;
