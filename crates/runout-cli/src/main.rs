@@ -24,18 +24,18 @@ struct Cli {
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
     Simulate(cmd::simulate::Args),
-    /// Tool grinding: compensate the bar clamping error (probe grid → wheel path / NC program).
-    Grind(cmd::grind::Args),
     /// Identify runout (and cutting coefficients) from measured forces.
     Identify(cmd::identify::Args),
+    /// Tool grinding: compensate the bar clamping error (probe grid → wheel path / NC program).
+    Grind(cmd::grind::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
-        Command::Grind(a) => cmd::grind::run(a),
         Command::Identify(a) => cmd::identify::run(a),
+        Command::Grind(a) => cmd::grind::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

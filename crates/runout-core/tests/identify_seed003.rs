@@ -200,6 +200,17 @@ fn pooled_edge_aware_fit_matches_section_4_6() {
     );
     let r = analyse_tests(&t, SineHypothesis::Teeth).unwrap();
     assert_eq!(r.pooled.unwrap().edge_model, EdgeModel::ConstantPlusDepth);
+    assert_eq!(r.edge_corrected_offsets.unwrap().len(), 8);
+    // §4.6 table, per-test ρ (µm) with C − 32.7 N and with C − 114.2·a_z (H1 fits)
+    let r = analyse_tests(&t, SineHypothesis::ClosedPeriod).unwrap();
+    let c327 = [8.59, 8.70, 8.50, 8.71, 9.94, 8.73, 9.40, 9.61];
+    let c1142 = [12.1, 11.4, 10.8, 10.7, 11.6, 10.9, 12.2, 12.9];
+    for (j, tr) in r.tests.iter().enumerate() {
+        let a = tr.fit.edge_corrected_offset(32.7) * 1e3;
+        let b = tr.fit.edge_corrected_offset(114.2 * tr.ap_mm) * 1e3;
+        assert!((a - c327[j]).abs() < 0.011, "test {}: {a}", j + 1);
+        assert!((b - c1142[j]).abs() < 0.051, "test {}: {b}", j + 1);
+    }
 }
 
 #[test]

@@ -120,10 +120,22 @@ pub fn read_peak_table(path: &Path) -> Result<PeakTable, PeakTableError> {
 /// Parse a TOML peak table.
 pub fn parse_toml(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
     let t: TomlTable = toml::from_str(text).map_err(|e: toml::de::Error| {
-        let line = e
+        let mut line = e
             .span()
             .map(|s| text[..s.start.min(text.len())].lines().count().max(1))
             .unwrap_or(0);
+        // an unknown key inside a flattened table is reported at the table's start: find it
+        if let Some(name) = e.message().split('`').nth(1) {
+            if e.message().starts_with("unknown field") {
+                if let Some(i) = text.lines().position(|l| {
+                    l.trim_start()
+                        .strip_prefix(name)
+                        .is_some_and(|r| r.trim_start().starts_with('='))
+                }) {
+                    line = i + 1;
+                }
+            }
+        }
         PeakTableError {
             file: file.into(),
             line,

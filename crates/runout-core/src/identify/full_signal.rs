@@ -752,6 +752,13 @@ pub fn full_signal_fit(
             direction[1].atan2(direction[0]).to_degrees()
         ));
     }
+    if tss > 0.0 && rss / tss > 0.1 {
+        warnings.push(format!(
+            "poor fit: R² = {:.3} (the model explains < 90 % of the waveform variance) — check the \
+             cut conditions, the axis mapping and the spindle-angle reference",
+            1.0 - rss / tss
+        ));
+    }
     if coef_idx.len() < 6 {
         warnings.push("no F_z measured: K_ac and K_ae not identified (fixed at 0)".into());
     }

@@ -11,7 +11,27 @@
 //! * [`calibrate_mean_forces`] — coefficients from mean forces over ≥ 2 feeds (Altintas).
 //! * [`frequency_estimate`] — spindle-harmonic runout estimate (§4.7), a fast start value.
 //! * [`full_signal_fit`] — non-linear least squares of averaged waveforms (runout vector, tilt,
-//!   six coefficients), several recordings jointly; works for K = 2.
+//!   six coefficients), several recordings jointly; works for K = 2 with a helical cutter (with
+//!   straight flutes only the offset along the tooth line is observable, reported as such).
+//!
+//! From a recording: synchronously average whole revolutions on a uniform spindle-angle grid
+//! whose θ = 0 puts tooth 0's tip at immersion 0 ([`AveragedWaveform::average`]), wrap it with
+//! the cutter and cut in a [`WaveformCase`], and fit:
+//!
+//! ```
+//! use runout_core::identify::*;
+//! use runout_core::*;
+//! let cutter = Cutter::flat(10.0, 4, 0.0)?;
+//! let runout = Runout::new(0.008, 0.5)?;
+//! let cut = Cut::new(3000.0, 0.08, 1.0)?.radial(3.0, MillingMode::Down, &cutter)?;
+//! let kc = CuttingCoefficients::new([1889.2, 806.1, 291.0], [63.12, 113.7, -3.1])?;
+//! let model = ForceModel { cutter: cutter.clone(), runout, cut, coefficients: kc };
+//! let s = model.simulate(&ArcChip::new(&cutter, &runout, 0.08)?, &Sampling::new(3.0, 1.0, 1)?);
+//! let w = AveragedWaveform::average(0.0, 360, &[(Axis::X, &s.fx), (Axis::Y, &s.fy)])?;
+//! let fit = full_signal_fit(&[WaveformCase { cutter, cut, waveform: w }], &FullSignalOptions::default())?;
+//! assert!((fit.offset.value - 0.008).abs() < 1e-5 && (fit.angle.value - 0.5).abs() < 1e-3);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 mod error;
 mod frequency;

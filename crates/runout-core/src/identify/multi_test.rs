@@ -64,6 +64,9 @@ pub struct MultiTestResult {
     pub pooled: Option<PooledFit>,
     /// Pooled fit without an edge term, for comparison.
     pub pooled_no_edge: Option<PooledFit>,
+    /// Per-test offsets (mm) with C corrected by the pooled fit's edge force C₀ + E·a_p
+    /// ([`SineFit::edge_corrected_offset`]), when the pooled fit exists.
+    pub edge_corrected_offsets: Option<Vec<f64>>,
 }
 
 fn distinct(values: impl Iterator<Item = f64>) -> usize {
@@ -132,6 +135,19 @@ pub fn analyse_tests(
     }
     let n = results.len() as f64;
     let pooled_ok = n_fz >= 2 && n_fa >= 2 && k >= 3;
+    let pooled = if pooled_ok {
+        Some(pooled_fit(tests, EdgeModel::ConstantPlusDepth)?)
+    } else {
+        None
+    };
+    let edge_corrected_offsets = pooled.as_ref().map(|p| {
+        let c0 = p.constant_n.map(|e| e.value).unwrap_or(0.0);
+        let e = p.edge_n_per_mm.map(|e| e.value).unwrap_or(0.0);
+        results
+            .iter()
+            .map(|r| r.fit.edge_corrected_offset(c0 + e * r.ap_mm))
+            .collect()
+    });
     Ok(MultiTestResult {
         amplitude_vs_ap: line(&ap, &amp, true, n_ap),
         amplitude_vs_ap_origin: line(&ap, &amp, false, n_ap),
@@ -139,11 +155,8 @@ pub fn analyse_tests(
         mean_vs_fz_ap_origin: line(&fa, &mean, false, n_fa),
         vector_mean: ((sx / n).hypot(sy / n), (sy / n).atan2(sx / n)),
         arithmetic_mean: (so / n, sa / n),
-        pooled: if pooled_ok {
-            Some(pooled_fit(tests, EdgeModel::ConstantPlusDepth)?)
-        } else {
-            None
-        },
+        pooled,
+        edge_corrected_offsets,
         pooled_no_edge: if pooled_ok {
             Some(pooled_fit(tests, EdgeModel::None)?)
         } else {

@@ -364,3 +364,23 @@ pub fn sine_fit(
         warnings,
     })
 }
+
+impl SineFit {
+    /// Offset ρ (mm) with the mean C corrected for an edge (ploughing) force `edge_n` (N) that
+    /// does not depend on the chip: ρ = A/(C − C_edge)·f_z sin γ/(2 sin(π/K)) — the seed's
+    /// modified eq. (12) with C′ (methods.md §4.6). `edge_n` from a regression of C on f_z·a_p
+    /// (its intercept) or from the pooled fit (C₀ + E·a_p).
+    ///
+    /// ```
+    /// use runout_core::identify::{sine_fit, PeakConditions, SineHypothesis, ToothPeaks};
+    /// let p = ToothPeaks::new(vec![366.6, 307.9, 259.9, 326.6]).unwrap();
+    /// let f = sine_fit(&p, &PeakConditions { fz_mm: 0.08, sin_gamma: 0.8 }, SineHypothesis::ClosedPeriod).unwrap();
+    /// // methods.md §4.6: C − 32.7 N → 8.59 µm (test 1)
+    /// assert!((f.edge_corrected_offset(32.7) * 1e3 - 8.59).abs() < 0.01);
+    /// ```
+    pub fn edge_corrected_offset(&self, edge_n: f64) -> f64 {
+        let g = self.conditions.fz_mm * self.conditions.sin_gamma
+            / (2.0 * (PI / self.teeth as f64).sin());
+        self.amplitude.value / (self.mean.value - edge_n) * g
+    }
+}

@@ -163,7 +163,8 @@ fn result_json(r: &MultiTestResult, file: &str) -> serde_json::Value {
     let tests: Vec<serde_json::Value> = r
         .tests
         .iter()
-        .map(|t| {
+        .enumerate()
+        .map(|(i, t)| {
             let mut j = fit_json(
                 &t.fit,
                 json!({"fz_mm": t.fz_mm, "ap_mm": t.ap_mm,
@@ -176,6 +177,10 @@ fn result_json(r: &MultiTestResult, file: &str) -> serde_json::Value {
             o.insert("kt_N_per_mm2".into(), json!(t.coefficients.map(|c| c.kt)));
             o.insert("kr_N_per_mm2".into(), json!(t.coefficients.map(|c| c.kr)));
             o.insert("k_N_per_mm2".into(), json!(t.coefficients.map(|c| c.k)));
+            o.insert(
+                "offset_edge_corrected_um".into(),
+                json!(r.edge_corrected_offsets.as_ref().map(|v| v[i] * 1e3)),
+            );
             j
         })
         .collect();
