@@ -26,6 +26,9 @@ enum Command {
     Simulate(cmd::simulate::Args),
     /// Identify runout (and cutting coefficients) from measured forces.
     Identify(cmd::identify::Args),
+    /// Runout identified in position from displacement readings: per-tooth readings, runout at
+    /// several heights, or a raw signal (methods.md §1).
+    Displacement(cmd::displacement::Args),
     /// Tool grinding: compensate the bar clamping error (probe grid → wheel path / NC program).
     Grind(cmd::grind::Args),
 }
@@ -35,6 +38,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Identify(a) => cmd::identify::run(a),
+        Command::Displacement(a) => cmd::displacement::run(a),
         Command::Grind(a) => cmd::grind::run(a),
     };
     match result {

@@ -23,6 +23,7 @@ pub mod chip;
 pub mod coefficients;
 pub mod cut;
 pub mod cutter;
+pub mod displacement;
 pub mod error;
 pub mod force;
 pub mod grind;

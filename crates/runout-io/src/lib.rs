@@ -6,6 +6,8 @@
 #![warn(missing_docs)]
 
 pub mod config;
+pub mod displacement;
+pub mod displacement_plot;
 pub mod export;
 pub mod gcode;
 pub mod grind;

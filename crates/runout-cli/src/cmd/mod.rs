@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod displacement;
 pub mod grind;
 pub mod identify;
 pub mod simulate;
