@@ -33,6 +33,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod alignment;
 mod error;
 mod frequency;
 mod full_signal;
@@ -45,6 +46,7 @@ mod pooled;
 mod sine_fit;
 mod waveform;
 
+pub use alignment::{harmonic_start_angle, model_forces, refine_start_angle, residual_at};
 pub use error::IdentifyError;
 pub use frequency::{frequency_estimate, FrequencyEstimate};
 pub use full_signal::{full_signal_fit, FullSignalFit, FullSignalOptions, RunoutObservability};

@@ -1,17 +1,23 @@
-//! `runout identify …`: runout identification. Subcommands:
+//! `runout identify RECORDING… --config cut.toml`: runout and coefficients from force
+//! recordings (see [`recording`]). Subcommands:
 //! `peaks` (seed 003 sine fit of one per-tooth peak table) and `tests` (several tests from a
 //! CSV/TOML table: per-test fits, regressions, K_T/K_R, pooled edge-aware fit).
 
 pub mod peaks;
+pub mod recording;
 pub mod tests;
 
 use anyhow::Result;
 
-/// Arguments of `runout identify`.
+/// Arguments of `runout identify`: recordings (the main job), or a subcommand working on
+/// peak tables.
 #[derive(clap::Args, Debug)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct Args {
     #[command(subcommand)]
-    pub command: Command,
+    pub command: Option<Command>,
+    #[command(flatten)]
+    pub recording: recording::RecordingArgs,
 }
 
 /// `runout identify` subcommands.
@@ -26,8 +32,9 @@ pub enum Command {
 
 pub fn run(a: Args) -> Result<()> {
     match a.command {
-        Command::Peaks(p) => peaks::run(p),
-        Command::Tests(t) => tests::run(t),
+        Some(Command::Peaks(p)) => peaks::run(p),
+        Some(Command::Tests(t)) => tests::run(t),
+        None => recording::run(a.recording),
     }
 }
 
