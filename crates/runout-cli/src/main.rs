@@ -24,6 +24,8 @@ struct Cli {
 enum Command {
     /// Simulate milling forces with runout (mechanistic model, helical cutter in axial disks).
     Simulate(cmd::simulate::Args),
+    /// Identify runout (and cutting coefficients) from measured forces.
+    Identify(cmd::identify::Args),
     /// Runout identified in position from displacement readings: per-tooth readings, runout at
     /// several heights, or a raw signal (methods.md §1).
     Displacement(cmd::displacement::Args),
@@ -39,6 +41,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
+        Command::Identify(a) => cmd::identify::run(a),
         Command::Displacement(a) => cmd::displacement::run(a),
         Command::Chip(a) => cmd::chip::run(a),
         Command::Grind(a) => cmd::grind::run(a),
@@ -50,5 +53,16 @@ fn main() -> ExitCode {
             eprintln!("error: {e:#}");
             ExitCode::from(1)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Cli;
+    use clap::CommandFactory;
+
+    #[test]
+    fn command_line_definition_is_consistent() {
+        Cli::command().debug_assert();
     }
 }

@@ -27,8 +27,10 @@ pub mod displacement;
 pub mod error;
 pub mod force;
 pub mod grind;
+pub mod identify;
 pub mod runout;
 pub mod shank;
+pub mod signal;
 
 pub use chip::{ArcChip, ChipAtHeight, ChipThickness, EquivalentChip, ExactChip};
 pub use coefficients::CuttingCoefficients;

@@ -12,6 +12,7 @@ pub mod export;
 pub mod gcode;
 pub mod grind;
 pub mod lineplot;
+pub mod peak_table;
 pub mod plot;
 pub mod recording;
 pub mod toolpath;

@@ -1,7 +1,8 @@
 //! One module per subcommand.
 
-pub mod displacement;
 pub mod chip;
+pub mod displacement;
 pub mod grind;
+pub mod identify;
 pub mod shank;
 pub mod simulate;

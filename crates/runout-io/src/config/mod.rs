@@ -2,8 +2,9 @@
 //! plain numbers or strings with a matching unit suffix (`"8um"`). Every key also exists as a
 //! command-line flag; flags override the file.
 
-pub mod shank;
 pub mod chip;
+pub mod identify;
+pub mod shank;
 pub mod simulate;
 
 use crate::units::{parse_quantity, Quantity};
@@ -240,6 +241,7 @@ pub fn layer_from_toml(file: &str, text: &str, known: &[&str]) -> Result<Layer, 
             toml::Value::Integer(i) => Value::Number(i as f64),
             toml::Value::Float(f) => Value::Number(f),
             toml::Value::String(s) => Value::Text(s),
+            toml::Value::Boolean(b) => Value::Text(b.to_string()),
             toml::Value::Array(a) => {
                 let parts: Result<Vec<String>, ConfigError> = a
                     .into_iter()

@@ -152,17 +152,8 @@ fn key_err(s: &Settings, e: ParamError) -> ConfigError {
     }
 }
 
-/// Resolve the settings into model types, checking every value.
-///
-/// ```
-/// use runout_io::config::{layer_from_toml, Settings, simulate::{resolve_simulate, simulate_key_names}};
-/// let text = "teeth = 4\ndiameter_mm = 10\nrpm = 3240\nfz_mm = 0.08\nap_mm = 1\nae_mm = 2\nmode = \"down\"\nktc = 1889.2\nkrc = 806.1\nrunout_um = \"8um\"";
-/// let mut s = Settings::new();
-/// s.push(layer_from_toml("case.toml", text, &simulate_key_names()).unwrap());
-/// let case = resolve_simulate(&s).unwrap();
-/// assert!((case.runout.offset() - 0.008).abs() < 1e-15);
-/// ```
-pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
+/// The cutter keys (`teeth`, `diameter_mm`, `helix_deg`, `pitch_deg`, `flute_length_mm`).
+pub fn resolve_cutter(s: &Settings) -> Result<Cutter, ConfigError> {
     let teeth = s.count("teeth")?.ok_or_else(|| ConfigError::Missing {
         key: "teeth".into(),
         flag: "teeth".into(),
@@ -208,9 +199,14 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
     }
     .map_err(|e| key_err(s, e))?;
 
+    Ok(cutter)
+}
+
+/// The cut keys (`rpm`, `mode`, `ae_mm` or `entry_deg`/`exit_deg`) with a given feed per tooth
+/// and axial depth (mm), for `cutter`.
+pub fn resolve_cut(s: &Settings, cutter: &Cutter, fz: f64, ap: f64) -> Result<Cut, ConfigError> {
+    let d = cutter.diameter();
     let rpm = s.require("rpm", Quantity::SpeedRpm, "spindle speed")?;
-    let fz = s.require("fz_mm", Quantity::LengthMm, "feed per tooth")?;
-    let ap = s.require("ap_mm", Quantity::LengthMm, "axial depth of cut")?;
     let base = Cut::new(rpm, fz, ap).map_err(|e| key_err(s, e))?;
     if ap > cutter.flute_length() {
         return Err(ConfigError::Key {
@@ -241,6 +237,25 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
         base.radial(ae, mode, &cutter)
     }
     .map_err(|e| key_err(s, e))?;
+    Ok(cut)
+}
+
+/// Resolve the settings into model types, checking every value.
+///
+/// ```
+/// use runout_io::config::{layer_from_toml, Settings, simulate::{resolve_simulate, simulate_key_names}};
+/// let text = "teeth = 4\ndiameter_mm = 10\nrpm = 3240\nfz_mm = 0.08\nap_mm = 1\nae_mm = 2\nmode = \"down\"\nktc = 1889.2\nkrc = 806.1\nrunout_um = \"8um\"";
+/// let mut s = Settings::new();
+/// s.push(layer_from_toml("case.toml", text, &simulate_key_names()).unwrap());
+/// let case = resolve_simulate(&s).unwrap();
+/// assert!((case.runout.offset() - 0.008).abs() < 1e-15);
+/// ```
+pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
+    let cutter = resolve_cutter(s)?;
+    let helix = cutter.helix().to_degrees();
+    let fz = s.require("fz_mm", Quantity::LengthMm, "feed per tooth")?;
+    let ap = s.require("ap_mm", Quantity::LengthMm, "axial depth of cut")?;
+    let cut = resolve_cut(s, &cutter, fz, ap)?;
 
     let rho = s.or("runout_um", Quantity::LengthUm, 0.0)? * 1e-3;
     let lam = s.or("runout_angle_deg", Quantity::AngleDeg, 0.0)?;

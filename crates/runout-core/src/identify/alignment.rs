@@ -1,0 +1,179 @@
+//! Spindle angle of an averaged waveform when the recording has no absolute angle reference.
+//!
+//! Without a once-per-revolution mark whose angle to tooth 0 is known, the synchronous average
+//! starts at an arbitrary spindle angle θ₀. The full-signal fit needs θ₀ (tooth 0's tip at
+//! immersion θ at bin 0, `conventions.md`): an error δ rotates the projection of tangential and
+//! radial forces, so K_rc absorbs ≈ K_tc·δ (0.5° ≈ 2 % of K_rc).
+//!
+//! 1. [`harmonic_start_angle`]: the tooth-passing harmonic is runout-free in the linear chip model
+//!    (methods.md §4.7: F_K = K·f_t·Q_K), and a shift θ₀ multiplies the model's harmonic P_K by
+//!    e^{jKθ₀}; so θ₀ = arg(Σ_c M_K,c·conj(P_K,c))/K modulo 2π/K, with the branch nearest a
+//!    reference angle (the one that keeps the caller's tooth numbering).
+//! 2. [`refine_start_angle`]: given runout, the model is linear in the six coefficients, so the
+//!    residual after a linear least-squares solve is a cheap function of θ₀; a grid over ±w and a
+//!    parabola through the best three points give θ₀ to a small fraction of a degree.
+
+use super::model::{force_from_basis, RevolutionModel};
+use super::waveform::{Axis, WaveformCase};
+use crate::angle::wrap_pi;
+use crate::coefficients::CuttingCoefficients;
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::TAU;
+
+/// Axial disks for alignment evaluations: 0.25° of helix lag per disk, at most 400.
+fn disks(case: &WaveformCase) -> usize {
+    let lag = case.cut.ap() * case.cutter.tan_helix().abs() / case.cutter.radius();
+    ((lag / 0.25f64.to_radians()).ceil() as usize).clamp(1, 400)
+}
+
+/// Model forces per axis on the waveform's grid starting at `start` (rad).
+pub fn model_forces(
+    case: &WaveformCase,
+    start: f64,
+    e: [f64; 2],
+    tau: [f64; 2],
+    kc: &CuttingCoefficients,
+) -> [Vec<f64>; 3] {
+    let n = case.waveform.samples();
+    let b = RevolutionModel::new(&case.cutter, &case.cut, start, n, disks(case))
+        .base_sums(e, tau)
+        .base;
+    let f = |ax| {
+        b.iter()
+            .map(|s| force_from_basis(ax, s, kc))
+            .collect::<Vec<_>>()
+    };
+    [f(Axis::X), f(Axis::Y), f(Axis::Z)]
+}
+
+fn harmonic(v: &[f64], k: usize) -> (f64, f64) {
+    let n = v.len() as f64;
+    v.iter().enumerate().fold((0.0, 0.0), |(re, im), (j, x)| {
+        let a = TAU * (k * j) as f64 / n;
+        (re + x * a.cos(), im - x * a.sin())
+    })
+}
+
+/// θ₀ from the tooth-passing harmonic of the measured F_x, F_y against the model with runout `e`,
+/// tilt `tau` and coefficients `kc` (only the ratios matter), on the branch nearest `reference`.
+///
+/// ```
+/// use runout_core::*;
+/// use runout_core::identify::{harmonic_start_angle, AveragedWaveform, Axis, WaveformCase};
+/// let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+/// let cut = Cut::new(3000.0, 0.08, 2.0).unwrap().radial(2.0, MillingMode::Down, &cutter).unwrap();
+/// let kc = CuttingCoefficients::new([2000.0, 800.0, 300.0], [60.0, 100.0, 0.0]).unwrap();
+/// let m = ForceModel { cutter: cutter.clone(), runout: Runout::none(), cut, coefficients: kc };
+/// let s = m.simulate(&ArcChip::new(&cutter, &Runout::none(), 0.08).unwrap(), &Sampling::new(1.0, 1.0, 60).unwrap());
+/// // the same revolution seen from bin 0 at θ = 37°
+/// let rot = |v: &[f64]| (0..360).map(|j| v[(j + 37) % 360]).collect::<Vec<_>>();
+/// let w = AveragedWaveform::average(0.0, 360, &[(Axis::X, &rot(&s.fx)), (Axis::Y, &rot(&s.fy))]).unwrap();
+/// let case = WaveformCase { cutter, cut, waveform: w };
+/// let t0 = harmonic_start_angle(&case, [0.0; 2], [0.0; 2], &kc, 0.6);
+/// assert!((t0.to_degrees() - 37.0).abs() < 0.05);
+/// ```
+pub fn harmonic_start_angle(
+    case: &WaveformCase,
+    e: [f64; 2],
+    tau: [f64; 2],
+    kc: &CuttingCoefficients,
+    reference: f64,
+) -> f64 {
+    let k = case.cutter.teeth();
+    let model = model_forces(case, 0.0, e, tau, kc);
+    let (mut re, mut im) = (0.0, 0.0);
+    for c in &case.waveform.components {
+        let p = match c.axis {
+            Axis::X => &model[0],
+            Axis::Y => &model[1],
+            Axis::Z => continue,
+        };
+        let (mr, mi) = harmonic(&c.values, k);
+        let (pr, pi) = harmonic(p, k);
+        re += mr * pr + mi * pi;
+        im += mi * pr - mr * pi;
+    }
+    let base = im.atan2(re) / k as f64;
+    (0..k)
+        .map(|n| base + TAU * n as f64 / k as f64)
+        .min_by(|a, b| {
+            wrap_pi(a - reference)
+                .abs()
+                .total_cmp(&wrap_pi(b - reference).abs())
+        })
+        .unwrap_or(base)
+}
+
+/// Residual sum of squares (N²) of the waveform against the model started at `start`, with the
+/// coefficients solved by linear least squares for the given runout and tilt.
+pub fn residual_at(case: &WaveformCase, start: f64, e: [f64; 2], tau: [f64; 2]) -> f64 {
+    let n = case.waveform.samples();
+    let b = RevolutionModel::new(&case.cutter, &case.cut, start, n, disks(case))
+        .base_sums(e, tau)
+        .base;
+    let mut rows_xy: Vec<[f64; 4]> = Vec::new();
+    let mut y_xy: Vec<f64> = Vec::new();
+    let mut rows_z: Vec<[f64; 2]> = Vec::new();
+    let mut y_z: Vec<f64> = Vec::new();
+    for c in &case.waveform.components {
+        for (q, v) in c.values.iter().enumerate() {
+            let s = &b[q];
+            match c.axis {
+                // F_x = K_tc b0 + K_rc b1 + K_te b2 + K_re b3; F_y = −K_tc b1 + K_rc b0 − K_te b3 + K_re b2
+                Axis::X => rows_xy.push([s[0], s[1], s[2], s[3]]),
+                Axis::Y => rows_xy.push([-s[1], s[0], -s[3], s[2]]),
+                Axis::Z => {
+                    rows_z.push([-s[4], -s[5]]);
+                    y_z.push(*v);
+                    continue;
+                }
+            }
+            y_xy.push(*v);
+        }
+    }
+    lsq_rss(&rows_xy, &y_xy) + lsq_rss(&rows_z, &y_z)
+}
+
+fn lsq_rss<const P: usize>(rows: &[[f64; P]], y: &[f64]) -> f64 {
+    if rows.is_empty() {
+        return 0.0;
+    }
+    let x = DMatrix::from_fn(rows.len(), P, |r, c| rows[r][c]);
+    let yv = DVector::from_column_slice(y);
+    match x.clone().svd(true, true).solve(&yv, 1e-12) {
+        Ok(beta) => (yv - x * beta).norm_squared(),
+        Err(_) => yv.norm_squared(),
+    }
+}
+
+/// θ₀ minimising [`residual_at`] within ±`half_width` (rad) of `start`: a 41-point grid, then a
+/// parabola through the best point and its neighbours. Returns (θ₀, RSS).
+pub fn refine_start_angle(
+    case: &WaveformCase,
+    start: f64,
+    half_width: f64,
+    e: [f64; 2],
+    tau: [f64; 2],
+) -> (f64, f64) {
+    const N: usize = 41;
+    let step = 2.0 * half_width / (N - 1) as f64;
+    let grid: Vec<f64> = (0..N)
+        .map(|i| start - half_width + step * i as f64)
+        .collect();
+    let rss: Vec<f64> = grid.iter().map(|&t| residual_at(case, t, e, tau)).collect();
+    let best = (0..N)
+        .min_by(|&a, &b| rss[a].total_cmp(&rss[b]))
+        .unwrap_or(N / 2);
+    if best == 0 || best == N - 1 {
+        return (grid[best], rss[best]);
+    }
+    let (r0, r1, r2) = (rss[best - 1], rss[best], rss[best + 1]);
+    let denom = r0 - 2.0 * r1 + r2;
+    let shift = if denom > 0.0 {
+        0.5 * (r0 - r2) / denom
+    } else {
+        0.0
+    };
+    let t = grid[best] + shift.clamp(-1.0, 1.0) * step;
+    (t, residual_at(case, t, e, tau))
+}

@@ -1,0 +1,813 @@
+//! Full-signal identification (beyond seed 003): non-linear least squares of the synchronously
+//! averaged waveforms of all measured components of one or several recordings against the
+//! mechanistic force model with runout (issue 3 item 7).
+//!
+//! Model: [`RevolutionModel`] — the same equations and discretisation as
+//! [`crate::ForceModel::simulate`] with [`crate::ArcChip`]. Unknowns: the runout **vector**
+//! e = (ρ cos λ, ρ sin λ) (no singularity at ρ = 0; fitted in µm), optionally the tilt vector τ
+//! (µm/mm), and the cutting coefficients K_tc, K_rc, K_te, K_re (always) and K_ac, K_ae (only when an
+//! F_z component is measured; otherwise fixed at 0 and reported as not identified). Several
+//! recordings (e.g. different feeds) share all unknowns.
+//!
+//! Residuals r = (model − measured)/w with w the per-sample standard error when every component
+//! carries one, else w = 1 N. Solution in two stages:
+//! 1. on the *smooth* variant of the model (edge forces over the whole engagement window, which
+//!    makes the residuals continuous in the runout): a scan of the runout vector around the
+//!    start value (frequency-domain estimate §4.7 [`frequency_estimate`], or the caller's guess,
+//!    e.g. the sine fit) with the coefficients solved exactly by linear least squares at each
+//!    point (the forces are linear in them), then Levenberg–Marquardt (`levenberg-marquardt`
+//!    crate; analytic coefficient columns, central differences over ±0.1 µm for the runout);
+//! 2. on the *exact* model (edge forces only where h > 0, as the simulation): a derivative-free
+//!    compass search of the runout parameters on the profile cost (coefficients re-solved
+//!    linearly), because the exact residuals jump by K_e·dz wherever a tooth's chip crosses zero
+//!    and a gradient method stalls on those steps.
+//!
+//! Uncertainty: Cov = s²·(JᵀJ)⁻¹ at the solution with s² = Σr²/(n − p) (the "scaled" covariance:
+//! correct when the weights are right up to a common factor), standard errors from its diagonal,
+//! ρ and λ by the delta method from Cov(e_x, e_y). The condition number is that of J with unit-norm
+//! columns; above 1e8 the fit is flagged ill-conditioned. Averaged-waveform samples are treated
+//! as independent (true for white measurement noise; coloured noise makes the SEs optimistic).
+
+use super::error::IdentifyError;
+use super::frequency::{frequency_estimate, FrequencyEstimate};
+use super::lsq::linear_lsq;
+use super::model::{
+    coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel,
+};
+use super::sine_fit::Estimate;
+use super::waveform::{Axis, WaveformCase};
+use crate::coefficients::CuttingCoefficients;
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
+use serde::Serialize;
+
+/// Options of [`full_signal_fit`].
+#[derive(Debug, Clone, Default)]
+pub struct FullSignalOptions {
+    /// Axial disks of the model; `None` = automatic (helix lag a_p·tanβ/R ≤ 0.1° per disk, 1 for
+    /// straight flutes, at least 8 when fitting tilt, at most 2000). Coarser disks bias the
+    /// coefficients: 0.5° per disk gave −1.8 % on K_tc at a_p = 8 mm, 30° helix.
+    pub disks: Option<usize>,
+    /// Also fit the tilt vector τ.
+    pub fit_tilt: bool,
+    /// Start value of the runout vector e (mm); `None` = frequency-domain estimate.
+    pub initial_runout: Option<[f64; 2]>,
+}
+
+/// Result of the full-signal fit. Offsets mm, angles rad, coefficients N/mm² and N/mm.
+#[derive(Debug, Clone, Serialize)]
+pub struct FullSignalFit {
+    /// Runout offset ρ (mm).
+    pub offset: Estimate,
+    /// Runout angle λ (rad).
+    pub angle: Estimate,
+    /// Whether both components of the runout vector were identifiable.
+    pub observability: RunoutObservability,
+    /// Runout vector components e_x, e_y (mm).
+    pub vector: [Estimate; 2],
+    /// Tilt vector τ (mm/mm), when fitted.
+    pub tilt: Option<[Estimate; 2]>,
+    /// Fitted coefficients (K_ac, K_ae are 0 when no F_z was measured).
+    pub coefficients: [f64; 6],
+    /// Their standard errors (`None` = not identified / not fitted).
+    pub coefficient_se: [Option<f64>; 6],
+    /// Names of the fitted parameters, in the order of `correlation`.
+    pub parameters: Vec<String>,
+    /// Correlation matrix of the fitted parameters.
+    pub correlation: Vec<Vec<f64>>,
+    /// RMS of the unweighted residuals (N).
+    pub residual_rms_n: f64,
+    /// R² = 1 − RSS/TSS (unweighted, TSS about each component's mean).
+    pub r_squared: f64,
+    /// Condition number of the column-normalised Jacobian.
+    pub condition: f64,
+    /// True when the condition number exceeds 1e8.
+    pub ill_conditioned: bool,
+    /// Number of residuals n and residual degrees of freedom n − p.
+    pub n: usize,
+    /// Residual degrees of freedom.
+    pub dof: usize,
+    /// Model evaluations of the solver (stage-1 residual evaluations + stage-2 search points).
+    pub evaluations: usize,
+    /// Termination reason of the stage-1 Levenberg–Marquardt solver.
+    pub termination: String,
+    /// The start value from the frequency-domain estimate, when used.
+    pub initial: Option<FrequencyEstimate>,
+    /// Axial disks used.
+    pub disks: usize,
+    /// Warnings (ill-conditioning, non-convergence, coefficients not identified).
+    pub warnings: Vec<String>,
+}
+
+/// Which part of the runout vector the data determine.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunoutObservability {
+    /// Both components (offset and angle).
+    Full,
+    /// Only the component along `direction` (unit spindle-frame vector): K = 2 with straight
+    /// flutes and no tilt, where the offset across the tooth line changes no radius difference.
+    AlongDirection {
+        /// Unit vector of the observable direction.
+        direction: [f64; 2],
+    },
+}
+
+/// Check the runout columns of the Jacobian at the start point; when one direction is
+/// unobservable (singular-value ratio < 1e-4), restrict the fit to the observable one.
+fn runout_observability(p: &mut Problem<'_>) -> RunoutObservability {
+    p.analytic = true;
+    p.recompute();
+    let jac = p.jacobian();
+    p.analytic = false;
+    p.recompute();
+    let Some(j) = jac else {
+        return RunoutObservability::Full;
+    };
+    let g = j.columns(0, 2).transpose() * j.columns(0, 2);
+    let eig = nalgebra::SymmetricEigen::new(nalgebra::Matrix2::from_fn(|r, c| g[(r, c)]));
+    let (imax, imin) = if eig.eigenvalues[0] >= eig.eigenvalues[1] {
+        (0, 1)
+    } else {
+        (1, 0)
+    };
+    let (lmax, lmin) = (eig.eigenvalues[imax], eig.eigenvalues[imin].max(0.0));
+    if lmax > 0.0 && (lmin / lmax).sqrt() >= 1e-4 {
+        return RunoutObservability::Full;
+    }
+    let v = eig.eigenvectors.column(imax);
+    let d = [v[0], v[1]];
+    let (e, _) = p.runout();
+    let rest: Vec<f64> = p.x.iter().skip(2).copied().collect();
+    p.dirs = vec![d];
+    p.x = DVector::from_iterator(1 + rest.len(), std::iter::once(0.0).chain(rest));
+    p.set_runout(e);
+    p.recompute();
+    RunoutObservability::AlongDirection { direction: d }
+}
+
+/// Which coefficient indices (into [K_tc, K_rc, K_ac, K_te, K_re, K_ae]) are fitted.
+fn fitted_coefficients(cases: &[WaveformCase]) -> Vec<usize> {
+    let has_z = cases
+        .iter()
+        .any(|c| c.waveform.components.iter().any(|k| k.axis == Axis::Z));
+    if has_z {
+        vec![0, 1, 2, 3, 4, 5]
+    } else {
+        vec![0, 1, 3, 4]
+    }
+}
+
+/// Automatic disk count: helix lag a_p·tanβ/R per disk ≤ 0.1°.
+fn auto_disks(cases: &[WaveformCase], tilt: bool) -> usize {
+    let lag = cases
+        .iter()
+        .map(|c| {
+            (c.cut.ap() * c.cutter.tan_helix() / c.cutter.radius())
+                .abs()
+                .to_degrees()
+        })
+        .fold(0.0, f64::max);
+    let d = (lag / 0.1).ceil().max(1.0) as usize;
+    if tilt { d.max(8) } else { d }.min(2000)
+}
+
+#[derive(Clone)]
+struct Problem<'a> {
+    cases: &'a [WaveformCase],
+    models: Vec<RevolutionModel>,
+    coef_idx: Vec<usize>,
+    fit_tilt: bool,
+    /// Directions spanning the fitted runout vector: e = Σ t_k·d_k (both axes, or only the
+    /// observable one when the other is degenerate).
+    dirs: Vec<[f64; 2]>,
+    /// Parameters: t (µm) [, τ (µm/mm)], coefficients.
+    x: DVector<f64>,
+    sums: Vec<BasisSums>,
+    weights: bool,
+    /// Use the analytic runout derivatives (covariance) instead of central differences (solver).
+    analytic: bool,
+}
+
+impl Problem<'_> {
+    fn n_runout(&self) -> usize {
+        self.dirs.len() + if self.fit_tilt { 2 } else { 0 }
+    }
+    fn runout(&self) -> ([f64; 2], [f64; 2]) {
+        let mut e = [0.0; 2];
+        for (k, d) in self.dirs.iter().enumerate() {
+            e[0] += self.x[k] * d[0] * 1e-3;
+            e[1] += self.x[k] * d[1] * 1e-3;
+        }
+        let nd = self.dirs.len();
+        let t = if self.fit_tilt {
+            [self.x[nd] * 1e-3, self.x[nd + 1] * 1e-3]
+        } else {
+            [0.0, 0.0]
+        };
+        (e, t)
+    }
+    /// Switch all models between the smooth (edge forces over the window) and exact variants.
+    fn set_smooth(&mut self, smooth: bool) {
+        for m in &mut self.models {
+            m.edge_in_window = smooth;
+        }
+        self.recompute();
+    }
+    /// Set the runout vector e (mm), projected on the fitted directions.
+    fn set_runout(&mut self, e: [f64; 2]) {
+        for k in 0..self.dirs.len() {
+            let d = self.dirs[k];
+            self.x[k] = (e[0] * d[0] + e[1] * d[1]) * 1e3;
+        }
+    }
+    fn coefficients(&self) -> CuttingCoefficients {
+        let mut a = [0.0; 6];
+        let nr = self.n_runout();
+        for (p, &i) in self.coef_idx.iter().enumerate() {
+            a[i] = self.x[nr + p];
+        }
+        CuttingCoefficients::from_array(a)
+    }
+    fn weight(&self, c: usize, comp: usize, q: usize) -> f64 {
+        if self.weights {
+            self.cases[c].waveform.components[comp]
+                .se
+                .as_ref()
+                .map(|s| s[q])
+                .unwrap_or(1.0)
+        } else {
+            1.0
+        }
+    }
+    /// Model sums at the current parameters (with the analytic runout derivatives only when
+    /// `analytic` is set — the solver's Jacobian uses differences).
+    fn recompute(&mut self) {
+        let (e, t) = self.runout();
+        let tilt = self.fit_tilt;
+        self.sums = if self.analytic {
+            self.models.iter().map(|m| m.sums(e, t, tilt)).collect()
+        } else {
+            self.models.iter().map(|m| m.base_sums(e, t)).collect()
+        };
+    }
+    fn n_residuals(&self) -> usize {
+        self.cases
+            .iter()
+            .map(|c| c.waveform.components.len() * c.waveform.samples())
+            .sum()
+    }
+    /// Unweighted model − measured.
+    fn raw_residuals(&self) -> Vec<f64> {
+        let kc = self.coefficients();
+        let mut r = Vec::with_capacity(self.n_residuals());
+        for (c, case) in self.cases.iter().enumerate() {
+            for comp in &case.waveform.components {
+                for (q, v) in comp.values.iter().enumerate() {
+                    r.push(force_from_basis(comp.axis, &self.sums[c].base[q], &kc) - v);
+                }
+            }
+        }
+        r
+    }
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, x: &DVector<f64>) {
+        self.x.copy_from(x);
+        self.recompute();
+    }
+    fn params(&self) -> DVector<f64> {
+        self.x.clone()
+    }
+    fn residuals(&self) -> Option<DVector<f64>> {
+        let raw = self.raw_residuals();
+        let mut i = 0;
+        let mut out = DVector::zeros(raw.len());
+        for (c, case) in self.cases.iter().enumerate() {
+            for (k, comp) in case.waveform.components.iter().enumerate() {
+                for q in 0..comp.values.len() {
+                    out[i] = raw[i] / self.weight(c, k, q);
+                    i += 1;
+                }
+            }
+        }
+        out.iter().all(|v| v.is_finite()).then_some(out)
+    }
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let nr = self.n_runout();
+        let np = self.x.len();
+        let mut j = DMatrix::zeros(self.n_residuals(), np);
+        // Runout columns by central differences over ±RUNOUT_STEP_UM (see the constant; forward
+        // differences stalled LM in the straight-flute edge-skipping round trip), or
+        // analytic (smooth part only) for the covariance.
+        let kc = self.coefficients();
+        let fd: Vec<DVector<f64>> = (0..nr)
+            .map(|p| {
+                if self.analytic {
+                    return self.analytic_runout_column(p, &kc);
+                }
+                let mut plus = self.clone();
+                plus.x[p] += RUNOUT_STEP_UM;
+                plus.recompute();
+                let fp = plus.raw_residuals();
+                let mut minus = self.clone();
+                minus.x[p] -= RUNOUT_STEP_UM;
+                minus.recompute();
+                let here = minus.raw_residuals();
+                DVector::from_iterator(
+                    fp.len(),
+                    fp.iter()
+                        .zip(&here)
+                        .map(|(a, b)| (a - b) / (2.0 * RUNOUT_STEP_UM)),
+                )
+            })
+            .collect();
+        let mut row = 0;
+        for (c, case) in self.cases.iter().enumerate() {
+            let s = &self.sums[c];
+            for (k, comp) in case.waveform.components.iter().enumerate() {
+                for q in 0..comp.values.len() {
+                    let w = self.weight(c, k, q);
+                    for (p, col) in fd.iter().enumerate() {
+                        j[(row, p)] = col[row] / w;
+                    }
+                    let g = coefficient_gradient(comp.axis, &s.base[q]);
+                    for (p, &i) in self.coef_idx.iter().enumerate() {
+                        j[(row, nr + p)] = g[i] / w;
+                    }
+                    row += 1;
+                }
+            }
+        }
+        Some(j)
+    }
+}
+
+impl Problem<'_> {
+    /// Analytic ∂(model)/∂x_p (N per µm or per µm/mm) of runout parameter p, unweighted.
+    fn analytic_runout_column(&self, p: usize, kc: &CuttingCoefficients) -> DVector<f64> {
+        let nd = self.dirs.len();
+        let mut out = Vec::with_capacity(self.n_residuals());
+        for (c, case) in self.cases.iter().enumerate() {
+            let s = &self.sums[c];
+            for comp in &case.waveform.components {
+                for q in 0..comp.values.len() {
+                    let de = |i: usize| runout_gradient(comp.axis, &s.deriv[q][i], kc);
+                    let v = if p < nd {
+                        let d = self.dirs[p];
+                        de(0) * d[0] + de(1) * d[1]
+                    } else {
+                        de(2 + p - nd)
+                    };
+                    out.push(v * 1e-3);
+                }
+            }
+        }
+        DVector::from_vec(out)
+    }
+}
+
+/// Profile cost: coefficients solved exactly (linear) at the current runout; weighted RSS.
+fn profile_cost(p: &mut Problem<'_>) -> f64 {
+    match linear_coefficients(p) {
+        Ok(()) => p
+            .residuals()
+            .map(|r| r.norm_squared())
+            .unwrap_or(f64::INFINITY),
+        Err(_) => f64::INFINITY,
+    }
+}
+
+/// Stage 2 of the fit: compass (pattern) search of the runout parameters on the **exact** model's
+/// profile cost (coefficients re-solved linearly at each point). Derivative-free, so the
+/// edge-force steps of the exact model (see [`RUNOUT_STEP_UM`]) cannot stall it; steps from
+/// max(0.5 µm, 5 % of ρ) halved down to 0.005 µm. Returns the number of model evaluations.
+fn pattern_search(p: &mut Problem<'_>) -> usize {
+    let nr = p.n_runout();
+    let x0 = p.x.clone();
+    p.set_params(&x0);
+    let dirs = search_directions(p);
+    let mut best = profile_cost(p);
+    let mut x = p.x.clone();
+    let (e, _) = p.runout();
+    let mut step = (0.05 * e[0].hypot(e[1]) * 1e3).max(0.5);
+    let mut evals = 1;
+    while step > 0.005 && evals < 600 {
+        let mut moved = false;
+        for d in &dirs {
+            for sign in [1.0, -1.0] {
+                let mut trial = x.clone();
+                for k in 0..nr {
+                    trial[k] += sign * step * d[k];
+                }
+                p.set_params(&trial);
+                let c = profile_cost(p);
+                evals += 1;
+                if c < best {
+                    best = c;
+                    x = p.x.clone();
+                    moved = true;
+                    break;
+                }
+            }
+        }
+        if !moved {
+            step *= 0.5;
+        }
+    }
+    p.set_params(&x);
+    evals
+}
+
+/// Search directions for [`pattern_search`]: eigenvectors of the profile Gauss–Newton matrix of
+/// the runout parameters (analytic Jacobian with the coefficient columns projected out), scaled
+/// by 1/√eigenvalue relative to the least determined one — i.e. steps in standard-error units,
+/// so that a narrow diagonal valley (offset–tilt correlation) is followed instead of stalling.
+fn search_directions(p: &mut Problem<'_>) -> Vec<Vec<f64>> {
+    let nr = p.n_runout();
+    let axes = || {
+        (0..nr)
+            .map(|k| (0..nr).map(|j| if j == k { 1.0 } else { 0.0 }).collect())
+            .collect()
+    };
+    p.analytic = true;
+    p.recompute();
+    let jac = p.jacobian();
+    p.analytic = false;
+    p.recompute();
+    let Some(j) = jac else { return axes() };
+    let np = j.ncols();
+    let jr = j.columns(0, nr).into_owned();
+    let jc = j.columns(nr, np - nr).into_owned();
+    // residual of J_r after projecting on span(J_c): J_r − J_c (J_cᵀJ_c)⁻¹ J_cᵀ J_r
+    let Some(inv) = (jc.transpose() * &jc).try_inverse() else {
+        return axes();
+    };
+    let proj = &jr - &jc * (inv * (jc.transpose() * &jr));
+    let h = proj.transpose() * proj;
+    let eig = nalgebra::SymmetricEigen::new(h);
+    let lmin = eig
+        .eigenvalues
+        .iter()
+        .cloned()
+        .fold(f64::INFINITY, f64::min);
+    if lmin.is_nan() || lmin <= 0.0 {
+        return axes();
+    }
+    (0..nr)
+        .map(|k| {
+            let scale = (lmin / eig.eigenvalues[k]).sqrt();
+            eig.eigenvectors
+                .column(k)
+                .iter()
+                .map(|v| v * scale)
+                .collect()
+        })
+        .collect()
+}
+
+/// Linear least squares of the coefficients at the problem's current runout.
+fn linear_coefficients(p: &mut Problem<'_>) -> Result<(), IdentifyError> {
+    let nr = p.n_runout();
+    let ncoef = p.coef_idx.len();
+    p.recompute();
+    // weighted design (the sums do not depend on the coefficients) and measured values
+    let n = p.n_residuals();
+    let mut x = DMatrix::zeros(n, ncoef);
+    let mut y = DVector::zeros(n);
+    let mut row = 0;
+    for (c, case) in p.cases.iter().enumerate() {
+        for (k, comp) in case.waveform.components.iter().enumerate() {
+            for (q, v) in comp.values.iter().enumerate() {
+                let w = p.weight(c, k, q);
+                let g = coefficient_gradient(comp.axis, &p.sums[c].base[q]);
+                for (j, &i) in p.coef_idx.iter().enumerate() {
+                    x[(row, j)] = g[i] / w;
+                }
+                y[row] = v / w;
+                row += 1;
+            }
+        }
+    }
+    let fit = linear_lsq("coefficient start values", &x, &y)?;
+    for c in 0..ncoef {
+        p.x[nr + c] = fit.beta[c];
+    }
+    Ok(())
+}
+
+/// Step (µm, or µm/mm for tilt) of the central differences for the runout columns of the
+/// Jacobian. The analytic derivative ([`RevolutionModel::sums`]) misses the edge-force switch at
+/// h = 0: where a tooth's chip vanishes inside the engagement (edge skipping, up-milling entry)
+/// moving the runout moves that boundary, and with many axial disks the sum of the small steps is
+/// a real slope. Ignoring it stalled LM 1.9 µm from the optimum (K = 2, ρ = 27 µm); a 0.1 µm
+/// difference spans enough steps to see the macroscopic slope.
+const RUNOUT_STEP_UM: f64 = 0.1;
+
+const NAMES: [&str; 6] = ["ktc", "krc", "kac", "kte", "kre", "kae"];
+
+/// Identify runout (and tilt) and the cutting coefficients from averaged waveforms.
+pub fn full_signal_fit(
+    cases: &[WaveformCase],
+    options: &FullSignalOptions,
+) -> Result<FullSignalFit, IdentifyError> {
+    if cases.is_empty() {
+        return Err(IdentifyError::too_few("full-signal fit", "1 recording", 0));
+    }
+    for c in cases {
+        c.waveform.validate()?;
+    }
+    let weights = cases
+        .iter()
+        .all(|c| c.waveform.components.iter().all(|k| k.se.is_some()));
+    let disks = options
+        .disks
+        .unwrap_or_else(|| auto_disks(cases, options.fit_tilt))
+        .max(1);
+    let coef_idx = fitted_coefficients(cases);
+    let nr_full = if options.fit_tilt { 4 } else { 2 };
+    let np_full = nr_full + coef_idx.len();
+    let models: Vec<RevolutionModel> = cases
+        .iter()
+        .map(|c| {
+            RevolutionModel::new(
+                &c.cutter,
+                &c.cut,
+                c.waveform.start_angle,
+                c.waveform.samples(),
+                disks,
+            )
+        })
+        .collect();
+    let mut problem = Problem {
+        cases,
+        models,
+        coef_idx: coef_idx.clone(),
+        fit_tilt: options.fit_tilt,
+        dirs: vec![[1.0, 0.0], [0.0, 1.0]],
+        x: DVector::zeros(np_full),
+        sums: Vec::new(),
+        weights,
+        analytic: false,
+    };
+    let n = problem.n_residuals();
+    if n <= np_full {
+        return Err(IdentifyError::too_few(
+            "full-signal fit",
+            format!("more than {np_full} samples"),
+            n,
+        ));
+    }
+    // Start values: the frequency-domain estimate (§4.7) and the caller's guess, then a coarse
+    // scan of the runout vector (16 angles × 3 offsets around the estimate) with the exactly
+    // solved coefficients at each point; LM runs from the best (and from the second best when its cost is within 2×) — with edge skipping (large ρ,
+    // K = 2) the cost has local minima the frequency estimate alone can fall into.
+    linear_coefficients(&mut problem)?;
+    let mut initial = None;
+    let mut e_start = options.initial_runout.unwrap_or([0.0, 0.0]);
+    if let Ok(f) = frequency_estimate(cases, &problem.coefficients(), disks) {
+        initial = Some(f);
+        if options.initial_runout.is_none() {
+            e_start = f.vector;
+        }
+    }
+    problem.set_runout(e_start);
+    linear_coefficients(&mut problem)?;
+    // Observability of the runout direction: with K = 2 straight flutes the offset across the
+    // tooth line changes no radius difference (methods.md §4.2/§1.5 mirror ambiguity).
+    let observability = runout_observability(&mut problem);
+    let nr = problem.n_runout();
+    let np = problem.x.len();
+    let mut candidates = vec![e_start];
+    if let Some(f) = initial {
+        candidates.push(f.vector);
+    }
+    let r0 = candidates
+        .iter()
+        .map(|e| e[0].hypot(e[1]))
+        .fold(0.002, f64::max);
+    for scale in [0.5, 1.0, 1.5] {
+        for a in 0..16 {
+            let (s, c) = (a as f64 * std::f64::consts::TAU / 16.0).sin_cos();
+            candidates.push([r0 * scale * c, r0 * scale * s]);
+        }
+    }
+    // Stage 1 on the smooth variant of the model (edge forces over the whole engagement window,
+    // continuous in e): scan, then LM. Stage 2: derivative-free pattern search on the exact model
+    // (edge forces only where h > 0, as the simulation) from the stage-1 solution. With straight
+    // flutes the exact model's residuals jump by K_e·a_p where a tooth's chip crosses 0 and LM
+    // stalls there (round trip K = 6, ρ = 28 µm: 3 µm off; K = 3, ρ = 3 µm: 0.16 µm off).
+    problem.set_smooth(true);
+    let mut scored: Vec<(f64, DVector<f64>)> = Vec::with_capacity(candidates.len());
+    for e in candidates {
+        problem.x.fill(0.0);
+        problem.set_runout(e);
+        if linear_coefficients(&mut problem).is_ok() {
+            if let Some(r) = problem.residuals() {
+                scored.push((r.norm_squared(), problem.x.clone()));
+            }
+        }
+    }
+    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let lm = || LevenbergMarquardt::new().with_patience(200);
+    let mut best: Option<(Problem<'_>, levenberg_marquardt::MinimizationReport<f64>)> = None;
+    // second start only when its scan cost is comparable (within 2×) to the best one's
+    let best_cost = scored.first().map(|c| c.0).unwrap_or(f64::INFINITY);
+    for (_, x) in scored.iter().take(2).filter(|c| c.0 <= 2.0 * best_cost) {
+        let mut start = problem.clone();
+        start.set_params(x);
+        let (done, report) = lm().minimize(start);
+        let better = best
+            .as_ref()
+            .is_none_or(|(_, r)| report.objective_function < r.objective_function);
+        if better {
+            best = Some((done, report));
+        }
+    }
+    let best = best.map(|(mut p, r1)| {
+        p.set_smooth(false);
+        let evals = pattern_search(&mut p);
+        let mut r = r1;
+        r.number_of_evaluations += evals;
+        (p, r)
+    });
+    let (mut problem, report) =
+        best.ok_or_else(|| IdentifyError::singular("full-signal fit", "no valid start value"))?;
+    // Covariance from the analytic (smooth) runout derivatives: the differences also catch the
+    // edge-force steps, which carry no statistical information per sample and would inflate JᵀJ
+    // (standard errors 5× too small in the round-trip tests).
+    problem.analytic = true;
+    problem.recompute();
+    let jac = problem
+        .jacobian()
+        .ok_or_else(|| IdentifyError::singular("full-signal fit", "Jacobian"))?;
+    let res = problem
+        .residuals()
+        .ok_or_else(|| IdentifyError::singular("full-signal fit", "non-finite residuals"))?;
+    let raw = problem.raw_residuals();
+    let rss_w = res.norm_squared();
+    let dof = n - np;
+    let s2 = rss_w / dof as f64;
+
+    // Condition number of the column-normalised Jacobian, and the covariance.
+    let norms: Vec<f64> = (0..np)
+        .map(|c| jac.column(c).norm().max(f64::MIN_POSITIVE))
+        .collect();
+    let jn = DMatrix::from_fn(n, np, |r, c| jac[(r, c)] / norms[c]);
+    let svd = jn.svd(false, true);
+    let (smax, smin) = (svd.singular_values.max(), svd.singular_values.min());
+    let condition = if smin > 0.0 {
+        smax / smin
+    } else {
+        f64::INFINITY
+    };
+    let v_t = svd.v_t.as_ref().expect("V computed");
+    let inv = DMatrix::from_diagonal(&svd.singular_values.map(|s| {
+        if s > 0.0 {
+            1.0 / (s * s)
+        } else {
+            f64::INFINITY
+        }
+    }));
+    let cov_n = v_t.transpose() * inv * v_t;
+    let cov = DMatrix::from_fn(np, np, |r, c| cov_n[(r, c)] * s2 / (norms[r] * norms[c]));
+    let se = |i: usize| cov[(i, i)].max(0.0).sqrt();
+    let correlation: Vec<Vec<f64>> = (0..np)
+        .map(|r| (0..np).map(|c| cov[(r, c)] / (se(r) * se(c))).collect())
+        .collect();
+
+    // Runout in mm with delta-method ρ, λ: e = D·t, Cov(e) = D·Cov(t)·Dᵀ.
+    let ([ex, ey], _) = problem.runout();
+    let nd = problem.dirs.len();
+    let mut cov_e = [[0.0; 2]; 2];
+    for (a, row) in cov_e.iter_mut().enumerate() {
+        for (b, v) in row.iter_mut().enumerate() {
+            for p in 0..nd {
+                for q in 0..nd {
+                    *v += problem.dirs[p][a] * cov[(p, q)] * problem.dirs[q][b] * 1e-6;
+                }
+            }
+        }
+    }
+    let rho = ex.hypot(ey);
+    let quad = |g: [f64; 2]| {
+        (g[0] * g[0] * cov_e[0][0] + 2.0 * g[0] * g[1] * cov_e[0][1] + g[1] * g[1] * cov_e[1][1])
+            .max(0.0)
+            .sqrt()
+    };
+    let (g_rho, g_lam) = if rho > 0.0 {
+        ([ex / rho, ey / rho], [-ey / (rho * rho), ex / (rho * rho)])
+    } else {
+        ([f64::NAN; 2], [f64::NAN; 2])
+    };
+    let mut coefficients = [0.0; 6];
+    let mut coefficient_se = [None; 6];
+    for (p, &i) in coef_idx.iter().enumerate() {
+        coefficients[i] = problem.x[nr + p];
+        coefficient_se[i] = Some(se(nr + p));
+    }
+    let mut parameters: Vec<String> = if nd == 2 {
+        vec!["ex_um".to_string(), "ey_um".to_string()]
+    } else {
+        vec!["e_along_tooth_line_um".to_string()]
+    };
+    if options.fit_tilt {
+        parameters.extend([
+            "tilt_x_um_per_mm".to_string(),
+            "tilt_y_um_per_mm".to_string(),
+        ]);
+    }
+    parameters.extend(coef_idx.iter().map(|&i| NAMES[i].to_string()));
+
+    // R² about each component's mean, unweighted.
+    let mut tss = 0.0;
+    for case in cases {
+        for comp in &case.waveform.components {
+            let m = comp.values.iter().sum::<f64>() / comp.values.len() as f64;
+            tss += comp.values.iter().map(|v| (v - m).powi(2)).sum::<f64>();
+        }
+    }
+    let rss: f64 = raw.iter().map(|r| r * r).sum();
+    let ill = condition.is_nan() || condition >= 1e8;
+    let mut warnings = Vec::new();
+    if ill {
+        warnings.push(format!(
+            "ill-conditioned fit (condition number {condition:.3e}): the parameters are not separately identifiable from these recordings (see the correlation matrix); add feeds or components"
+        ));
+    }
+    if !report.termination.was_successful() {
+        warnings.push(format!("solver did not converge: {:?}", report.termination));
+    }
+    if let RunoutObservability::AlongDirection { direction } = observability {
+        warnings.push(format!(
+            "runout only partly observable (K = 2, straight flutes, no tilt): only the component \
+             along the tooth line (spindle-frame direction {:.1}°) changes the chip thickness; \
+             the offset reported is that component, a lower bound of ρ, and the angle is not \
+             identified (use a helical cutter, or a displacement measurement)",
+            direction[1].atan2(direction[0]).to_degrees()
+        ));
+    }
+    if tss > 0.0 && rss / tss > 0.1 {
+        warnings.push(format!(
+            "poor fit: R² = {:.3} (the model explains < 90 % of the waveform variance) — check the \
+             cut conditions, the axis mapping and the spindle-angle reference",
+            1.0 - rss / tss
+        ));
+    }
+    if coef_idx.len() < 6 {
+        warnings.push("no F_z measured: K_ac and K_ae not identified (fixed at 0)".into());
+    }
+    Ok(FullSignalFit {
+        offset: Estimate {
+            value: rho,
+            se: Some(quad(g_rho)),
+        },
+        angle: Estimate {
+            value: ey.atan2(ex),
+            se: (nd == 2).then(|| quad(g_lam)),
+        },
+        observability,
+        vector: [
+            Estimate {
+                value: ex,
+                se: Some(cov_e[0][0].max(0.0).sqrt()),
+            },
+            Estimate {
+                value: ey,
+                se: Some(cov_e[1][1].max(0.0).sqrt()),
+            },
+        ],
+        tilt: options.fit_tilt.then(|| {
+            [
+                Estimate {
+                    value: problem.x[nd] * 1e-3,
+                    se: Some(se(nd) * 1e-3),
+                },
+                Estimate {
+                    value: problem.x[nd + 1] * 1e-3,
+                    se: Some(se(nd + 1) * 1e-3),
+                },
+            ]
+        }),
+        coefficients,
+        coefficient_se,
+        parameters,
+        correlation,
+        residual_rms_n: (rss / n as f64).sqrt(),
+        r_squared: if tss > 0.0 { 1.0 - rss / tss } else { f64::NAN },
+        condition,
+        ill_conditioned: ill,
+        n,
+        dof,
+        evaluations: report.number_of_evaluations,
+        termination: format!("{:?}", report.termination),
+        initial,
+        disks,
+        warnings,
+    })
+}

@@ -1,0 +1,132 @@
+//! A chunk of consecutive samples of every channel, as a reader delivers them.
+
+use super::SignalError;
+
+/// Consecutive samples of the force channels (workpiece frame, N) and optionally a pulse channel.
+///
+/// All present slices must have the same length. A channel absent in the first chunk must stay
+/// absent (F_z absent is averaged as 0 and reported as absent).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Chunk<'a> {
+    /// F_x (N).
+    pub fx: &'a [f64],
+    /// F_y (N).
+    pub fy: &'a [f64],
+    /// F_z (N), if recorded.
+    pub fz: Option<&'a [f64]>,
+    /// Once-per-revolution / encoder channel (any unit), if recorded.
+    pub pulse: Option<&'a [f64]>,
+}
+
+impl<'a> Chunk<'a> {
+    /// F_x, F_y and F_z.
+    pub fn xyz(fx: &'a [f64], fy: &'a [f64], fz: &'a [f64]) -> Self {
+        Chunk {
+            fx,
+            fy,
+            fz: Some(fz),
+            pulse: None,
+        }
+    }
+    /// The same chunk with a pulse channel.
+    pub fn with_pulse(mut self, pulse: &'a [f64]) -> Self {
+        self.pulse = Some(pulse);
+        self
+    }
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.fx.len()
+    }
+    /// True when empty.
+    pub fn is_empty(&self) -> bool {
+        self.fx.is_empty()
+    }
+    /// Samples `a..b` of every channel.
+    pub fn slice(&self, a: usize, b: usize) -> Chunk<'a> {
+        Chunk {
+            fx: &self.fx[a..b],
+            fy: &self.fy[a..b],
+            fz: self.fz.map(|v| &v[a..b]),
+            pulse: self.pulse.map(|v| &v[a..b]),
+        }
+    }
+    /// (F_x, F_y, F_z) of sample `i` (F_z = 0 when absent).
+    #[inline]
+    pub fn force(&self, i: usize) -> [f64; 3] {
+        [self.fx[i], self.fy[i], self.fz.map_or(0.0, |v| v[i])]
+    }
+}
+
+/// Checks shared by the three passes: equal lengths, stable channel set, finite values.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ChunkGuard {
+    /// Samples seen so far (index of the next sample).
+    pub next: u64,
+    layout: Option<(bool, bool)>,
+}
+
+impl ChunkGuard {
+    /// Validate `c` (whose first sample is `self.next`) and advance.
+    pub fn check(&mut self, c: &Chunk, fs: f64, want_pulse: bool) -> Result<(), SignalError> {
+        let n = c.fx.len();
+        let start = self.next;
+        let bad = |what: String| SignalError::Channels {
+            sample: start,
+            what,
+        };
+        if c.fy.len() != n
+            || c.fz.is_some_and(|v| v.len() != n)
+            || c.pulse.is_some_and(|v| v.len() != n)
+        {
+            return Err(bad(format!(
+                "channel lengths differ (fx {}, fy {}, fz {:?}, pulse {:?})",
+                n,
+                c.fy.len(),
+                c.fz.map(|v| v.len()),
+                c.pulse.map(|v| v.len())
+            )));
+        }
+        let layout = (c.fz.is_some(), c.pulse.is_some());
+        match self.layout {
+            None => self.layout = Some(layout),
+            Some(l) if l != layout => {
+                return Err(bad(format!(
+                    "channel set changed (fz present {} → {}, pulse present {} → {})",
+                    l.0, layout.0, l.1, layout.1
+                )))
+            }
+            _ => {}
+        }
+        if want_pulse && c.pulse.is_none() {
+            return Err(bad(
+                "a pulse channel is configured but the chunk has none".into()
+            ));
+        }
+        let chans: [(&'static str, Option<&[f64]>); 4] = [
+            ("fx", Some(c.fx)),
+            ("fy", Some(c.fy)),
+            ("fz", c.fz),
+            ("pulse", c.pulse),
+        ];
+        for (name, v) in chans {
+            if let Some(v) = v {
+                if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                    let sample = start + i as u64;
+                    return Err(SignalError::NonFinite {
+                        channel: name,
+                        sample,
+                        time_s: sample as f64 / fs,
+                        value: v[i],
+                    });
+                }
+            }
+        }
+        self.next += n as u64;
+        Ok(())
+    }
+
+    /// Whether F_z was present (after the first chunk).
+    pub fn has_fz(&self) -> bool {
+        self.layout.is_some_and(|l| l.0)
+    }
+}

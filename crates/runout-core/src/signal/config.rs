@@ -1,0 +1,249 @@
+//! What the pipeline is told about a recording: sample rate, teeth, nominal speed, choices.
+
+use super::SignalError;
+use crate::error::{positive, ParamError};
+use serde::{Deserialize, Serialize};
+
+/// A force component (or the resultant |F_xy|) on the workpiece (`conventions.md`, "Frames").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Component {
+    /// F_x (feed direction).
+    Fx,
+    /// F_y (feed-normal direction).
+    Fy,
+    /// F_z (tool axis, up).
+    Fz,
+    /// Resultant |F_xy| = √(F_x² + F_y²).
+    Fxy,
+}
+
+impl Component {
+    /// All four, in the order of [`super::SyncAverage::components`].
+    pub const ALL: [Component; 4] = [Component::Fx, Component::Fy, Component::Fz, Component::Fxy];
+
+    /// Index into [`Component::ALL`].
+    pub fn index(self) -> usize {
+        match self {
+            Component::Fx => 0,
+            Component::Fy => 1,
+            Component::Fz => 2,
+            Component::Fxy => 3,
+        }
+    }
+
+    /// Name with unit, as used in result fields (`fx_N`, …, `fxy_N`).
+    pub fn name(self) -> &'static str {
+        ["fx_N", "fy_N", "fz_N", "fxy_N"][self.index()]
+    }
+
+    /// Value of this component from (F_x, F_y, F_z).
+    #[inline]
+    pub fn of(self, f: [f64; 3]) -> f64 {
+        match self {
+            Component::Fx => f[0],
+            Component::Fy => f[1],
+            Component::Fz => f[2],
+            // forces are far from overflow: the plain root is exact enough and 5× faster than hypot
+            Component::Fxy => (f[0] * f[0] + f[1] * f[1]).sqrt(),
+        }
+    }
+}
+
+impl std::str::FromStr for Component {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "fx" => Ok(Component::Fx),
+            "fy" => Ok(Component::Fy),
+            "fz" => Ok(Component::Fz),
+            "fxy" | "|fxy|" => Ok(Component::Fxy),
+            _ => Err(ParamError::new(
+                "peak_component",
+                "one of fx, fy, fz, fxy",
+                s,
+            )),
+        }
+    }
+}
+
+/// A once-per-revolution mark or an encoder channel (`conventions.md`, "Signals").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PulseConfig {
+    /// Rising edges per spindle revolution (1 for a once-per-rev mark, N for an N-line encoder).
+    /// With N > 1 the first edge of the section is taken as the revolution start, so the angle is
+    /// relative (an encoder's index channel is a once-per-rev mark: pass that for an absolute
+    /// angle); the angle between edges is interpolated piecewise linearly.
+    pub pulses_per_rev: usize,
+    /// Spindle angle θ (rad; tooth 0's tip at immersion θ, as in `ForceSeries::angle`) at the
+    /// rising edge (high-threshold crossing) of the once-per-rev mark. `None`: the angle is
+    /// relative to that edge. Only with `pulses_per_rev` = 1.
+    pub tooth0_angle_rad: Option<f64>,
+    /// Hysteresis thresholds (low, high) in the channel's unit; `None`: 30 % and 70 % of the
+    /// channel's range, found in pass 1.
+    pub thresholds: Option<(f64, f64)>,
+}
+
+impl PulseConfig {
+    /// A once-per-revolution mark with thresholds from the channel's range.
+    pub fn once_per_rev() -> Self {
+        PulseConfig {
+            pulses_per_rev: 1,
+            tooth0_angle_rad: None,
+            thresholds: None,
+        }
+    }
+}
+
+/// Configuration of the signal pipeline (`SignalConfig::new` for the defaults).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SignalConfig {
+    /// Sample rate f_s (Hz).
+    pub sample_rate_hz: f64,
+    /// Number of teeth K.
+    pub teeth: usize,
+    /// Nominal spindle speed n (rpm): the search for the tooth-passing line starts at K·n/60.
+    pub nominal_rpm: f64,
+    /// Relative half-width of the band around K·n/60 searched for the tooth-passing line
+    /// (default 0.10: the true speed must be within ±10 % of nominal).
+    pub search_band: f64,
+    /// Bins per revolution of the synchronous average; `None`: ≈ samples per revolution,
+    /// clamped to [64, 4096].
+    pub bins_per_rev: Option<usize>,
+    /// Component whose per-tooth peaks are reported (default |F_xy|).
+    pub peak_component: Component,
+    /// Section (from_s, to_s) to use instead of the automatic steady-cut detection.
+    pub section_s: Option<(f64, f64)>,
+    /// Pulse / encoder channel description, when the chunks carry one.
+    pub pulse: Option<PulseConfig>,
+    /// Entry immersion angle φ_st (rad) of the cut (`Cut::immersion`). With a pulse channel and
+    /// `tooth0_angle_rad` it makes tooth periods absolute: tooth i owns θ ∈ [φ_st + 2πi/K,
+    /// φ_st + 2π(i+1)/K) as in `force::tooth_peaks`.
+    pub entry_angle_rad: Option<f64>,
+    /// Subtract the air-cut mean force (the instrument's static offset, found by the steady-cut
+    /// detector) before averaging (default true; nothing is subtracted when there is no air cut).
+    pub subtract_air_offset: bool,
+}
+
+impl SignalConfig {
+    /// Defaults for a recording at `sample_rate_hz` of a `teeth`-tooth cutter at `nominal_rpm`.
+    pub fn new(sample_rate_hz: f64, teeth: usize, nominal_rpm: f64) -> Result<Self, SignalError> {
+        let c = SignalConfig {
+            sample_rate_hz,
+            teeth,
+            nominal_rpm,
+            search_band: 0.10,
+            bins_per_rev: None,
+            peak_component: Component::Fxy,
+            section_s: None,
+            pulse: None,
+            entry_angle_rad: None,
+            subtract_air_offset: true,
+        };
+        c.validate()?;
+        Ok(c)
+    }
+
+    /// Check every field; the accumulators call this too.
+    pub fn validate(&self) -> Result<(), SignalError> {
+        positive("sample_rate_hz", self.sample_rate_hz)?;
+        positive("nominal_rpm", self.nominal_rpm)?;
+        if self.teeth == 0 || self.teeth > 64 {
+            return Err(ParamError::new("teeth", "an integer in 1..=64", self.teeth).into());
+        }
+        if !(self.search_band > 0.0 && self.search_band < 0.5) {
+            return Err(
+                ParamError::new("search_band", "a fraction in (0, 0.5)", self.search_band).into(),
+            );
+        }
+        let tp = self.tooth_passing_hz() * (1.0 + self.search_band);
+        if tp >= 0.5 * self.sample_rate_hz {
+            return Err(ParamError::new(
+                "sample_rate_hz",
+                format!("> 2 × the tooth-passing band edge {tp:.1} Hz (Nyquist)"),
+                self.sample_rate_hz,
+            )
+            .into());
+        }
+        if self.samples_per_rev() > 1e7 {
+            return Err(ParamError::new(
+                "nominal_rpm",
+                "a speed giving at most 10^7 samples per revolution",
+                self.nominal_rpm,
+            )
+            .into());
+        }
+        if let Some(m) = self.bins_per_rev {
+            if !(8..=65536).contains(&m) {
+                return Err(ParamError::new("bins_per_rev", "an integer in 8..=65536", m).into());
+            }
+        }
+        if let Some((a, b)) = self.section_s {
+            if !(a.is_finite() && b.is_finite() && a >= 0.0 && b > a) {
+                return Err(ParamError::new(
+                    "from_s/to_s",
+                    "finite times with 0 <= from_s < to_s",
+                    format!("{a}..{b}"),
+                )
+                .into());
+            }
+        }
+        if let Some(p) = &self.pulse {
+            if p.pulses_per_rev == 0 || p.pulses_per_rev > 100_000 {
+                return Err(ParamError::new(
+                    "pulses_per_rev",
+                    "an integer in 1..=100000",
+                    p.pulses_per_rev,
+                )
+                .into());
+            }
+            if let Some((lo, hi)) = p.thresholds {
+                if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                    return Err(ParamError::new(
+                        "pulse_thresholds",
+                        "finite (low, high) with low < high",
+                        format!("({lo}, {hi})"),
+                    )
+                    .into());
+                }
+            }
+            if let Some(a) = p.tooth0_angle_rad {
+                crate::error::finite("tooth0_angle_rad", a)?;
+                if p.pulses_per_rev != 1 {
+                    return Err(ParamError::new(
+                        "tooth0_angle_rad",
+                        "no tooth-0 angle with an N-line encoder (pulses_per_rev > 1): give its index channel as a once-per-rev pulse",
+                        a,
+                    )
+                    .into());
+                }
+            }
+        }
+        if let Some(a) = self.entry_angle_rad {
+            crate::error::finite("entry_angle_rad", a)?;
+        }
+        Ok(())
+    }
+
+    /// Nominal spindle frequency n/60 (Hz).
+    pub fn spindle_hz(&self) -> f64 {
+        self.nominal_rpm / 60.0
+    }
+    /// Nominal tooth-passing frequency K·n/60 (Hz).
+    pub fn tooth_passing_hz(&self) -> f64 {
+        self.teeth as f64 * self.spindle_hz()
+    }
+    /// Nominal samples per revolution f_s·60/n.
+    pub fn samples_per_rev(&self) -> f64 {
+        self.sample_rate_hz / self.spindle_hz()
+    }
+    /// Bins per revolution actually used.
+    pub fn bins(&self) -> usize {
+        self.bins_per_rev
+            .unwrap_or_else(|| (self.samples_per_rev().round() as usize).clamp(64, 4096))
+    }
+    /// True when tooth periods are absolute (pulse with tooth-0 angle, and the entry angle).
+    pub fn absolute_teeth(&self) -> bool {
+        self.entry_angle_rad.is_some() && self.pulse.is_some_and(|p| p.tooth0_angle_rad.is_some())
+    }
+}

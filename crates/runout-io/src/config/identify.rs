@@ -1,0 +1,216 @@
+//! Keys of `runout identify RECORDING…`: the cutter and cut (as in `runout simulate`, without
+//! runout and coefficients, which are the unknowns), how to read the recordings, and the
+//! signal-pipeline options.
+
+use super::simulate::{resolve_cut, resolve_cutter};
+use super::{ConfigError, Settings};
+use crate::units::Quantity;
+use runout_core::{Cut, Cutter};
+
+/// Every key: (key, quantity, help). The flag is `--key-with-dashes`.
+pub const IDENTIFY_KEYS: &[(&str, Quantity, &str)] = &[
+    ("teeth", Quantity::Dimensionless, "number of teeth K"),
+    ("diameter_mm", Quantity::LengthMm, "cutter diameter D (mm)"),
+    (
+        "helix_deg",
+        Quantity::AngleDeg,
+        "helix angle (deg) [default 0]",
+    ),
+    (
+        "pitch_deg",
+        Quantity::AngleDeg,
+        "variable pitch angles (deg) [default uniform]",
+    ),
+    ("flute_length_mm", Quantity::LengthMm, "flute length (mm)"),
+    (
+        "rpm",
+        Quantity::SpeedRpm,
+        "nominal spindle speed (rpm); the actual speed is measured",
+    ),
+    (
+        "fz_mm",
+        Quantity::LengthMm,
+        "feed per tooth (mm); one value, or one per recording",
+    ),
+    (
+        "ap_mm",
+        Quantity::LengthMm,
+        "axial depth (mm); one value, or one per recording",
+    ),
+    ("ae_mm", Quantity::LengthMm, "radial depth (mm)"),
+    ("mode", Quantity::Dimensionless, "up | down | slot"),
+    (
+        "entry_deg",
+        Quantity::AngleDeg,
+        "explicit entry immersion angle (deg)",
+    ),
+    (
+        "exit_deg",
+        Quantity::AngleDeg,
+        "explicit exit immersion angle (deg)",
+    ),
+    (
+        "axes",
+        Quantity::Dimensionless,
+        "instrument channels → workpiece frame, e.g. \"x = -Fy, y = -Fx, z = -Fz\"",
+    ),
+    (
+        "sample_rate_hz",
+        Quantity::FrequencyHz,
+        "sample rate (Hz) when the file has neither a time column nor a rate line",
+    ),
+    (
+        "from_s",
+        Quantity::TimeS,
+        "start of the section to analyse (s) [default: detected steady cut]",
+    ),
+    ("to_s", Quantity::TimeS, "end of the section to analyse (s)"),
+    (
+        "peak_component",
+        Quantity::Dimensionless,
+        "component of the per-tooth peaks: fxy | fx | fy | fz [default fxy]",
+    ),
+    (
+        "pulse_channel",
+        Quantity::Dimensionless,
+        "once-per-revolution (or encoder) channel name",
+    ),
+    (
+        "pulses_per_rev",
+        Quantity::Dimensionless,
+        "pulses per revolution of the pulse channel [default 1]",
+    ),
+    (
+        "tooth0_angle_deg",
+        Quantity::AngleDeg,
+        "spindle angle of tooth 0 at the pulse edge (deg): makes tooth numbering absolute",
+    ),
+    (
+        "fit_tilt",
+        Quantity::Dimensionless,
+        "also fit the runout tilt (true/false) [default false]",
+    ),
+];
+
+/// Names of all keys.
+pub fn identify_key_names() -> Vec<&'static str> {
+    IDENTIFY_KEYS.iter().map(|k| k.0).collect()
+}
+
+/// A resolved identification case.
+#[derive(Debug, Clone)]
+pub struct IdentifyCase {
+    /// The cutter.
+    pub cutter: Cutter,
+    /// One cut per recording (feed and depth may differ).
+    pub cuts: Vec<Cut>,
+    /// Axis mapping text, if given.
+    pub axes: Option<String>,
+    /// Sample rate (Hz), if given.
+    pub sample_rate_hz: Option<f64>,
+    /// Section override (s).
+    pub section_s: Option<(f64, f64)>,
+    /// Peak component name.
+    pub peak_component: String,
+    /// Pulse channel name.
+    pub pulse_channel: Option<String>,
+    /// Pulses per revolution.
+    pub pulses_per_rev: usize,
+    /// Tooth-0 angle at the pulse edge (rad).
+    pub tooth0_angle: Option<f64>,
+    /// Fit the tilt too.
+    pub fit_tilt: bool,
+}
+
+fn per_recording(s: &Settings, key: &str, n: usize) -> Result<Vec<f64>, ConfigError> {
+    let v = s
+        .list(key, Quantity::LengthMm)?
+        .ok_or_else(|| ConfigError::Missing {
+            key: key.into(),
+            flag: key.replace('_', "-"),
+            what: "one value, or one per recording".into(),
+        })?;
+    match v.len() {
+        1 => Ok(vec![v[0]; n]),
+        m if m == n => Ok(v),
+        m => Err(ConfigError::Key {
+            source_name: s.origin(key).unwrap_or("config").into(),
+            key: key.into(),
+            message: format!("expected 1 value or {n} (one per recording), got {m}"),
+        }),
+    }
+}
+
+/// Resolve the settings for `recordings` recordings.
+pub fn resolve_identify(s: &Settings, recordings: usize) -> Result<IdentifyCase, ConfigError> {
+    let cutter = resolve_cutter(s)?;
+    let fz = per_recording(s, "fz_mm", recordings)?;
+    let ap = per_recording(s, "ap_mm", recordings)?;
+    let cuts = fz
+        .iter()
+        .zip(&ap)
+        .map(|(f, a)| resolve_cut(s, &cutter, *f, *a))
+        .collect::<Result<Vec<_>, _>>()?;
+    let section_s = match (
+        s.quantity("from_s", Quantity::TimeS)?,
+        s.quantity("to_s", Quantity::TimeS)?,
+    ) {
+        (None, None) => None,
+        (a, b) => {
+            let (a, b) = (a.unwrap_or(0.0), b.unwrap_or(f64::INFINITY));
+            if b <= a || a < 0.0 {
+                return Err(ConfigError::Key {
+                    source_name: s
+                        .origin("to_s")
+                        .or(s.origin("from_s"))
+                        .unwrap_or("config")
+                        .into(),
+                    key: "from_s/to_s".into(),
+                    message: format!("expected 0 <= from_s < to_s, got {a} and {b}"),
+                });
+            }
+            Some((a, b))
+        }
+    };
+    let peak_component = s
+        .text("peak_component")?
+        .unwrap_or_else(|| "fxy".into())
+        .to_ascii_lowercase();
+    if !["fxy", "fx", "fy", "fz"].contains(&peak_component.as_str()) {
+        return Err(ConfigError::Key {
+            source_name: s.origin("peak_component").unwrap_or("config").into(),
+            key: "peak_component".into(),
+            message: format!("expected fxy, fx, fy or fz, got `{peak_component}`"),
+        });
+    }
+    let fit_tilt = match s
+        .text("fit_tilt")?
+        .as_deref()
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        None | Some("false") | Some("no") => false,
+        Some("true") | Some("yes") => true,
+        Some(other) => {
+            return Err(ConfigError::Key {
+                source_name: s.origin("fit_tilt").unwrap_or("config").into(),
+                key: "fit_tilt".into(),
+                message: format!("expected true or false, got `{other}`"),
+            })
+        }
+    };
+    Ok(IdentifyCase {
+        cutter,
+        cuts,
+        axes: s.text("axes")?,
+        sample_rate_hz: s.quantity("sample_rate_hz", Quantity::FrequencyHz)?,
+        section_s,
+        peak_component,
+        pulse_channel: s.text("pulse_channel")?,
+        pulses_per_rev: s.count("pulses_per_rev")?.unwrap_or(1),
+        tooth0_angle: s
+            .quantity("tooth0_angle_deg", Quantity::AngleDeg)?
+            .map(f64::to_radians),
+        fit_tilt,
+    })
+}
