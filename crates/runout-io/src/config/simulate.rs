@@ -234,7 +234,7 @@ pub fn resolve_cut(s: &Settings, cutter: &Cutter, fz: f64, ap: f64) -> Result<Cu
         } else {
             s.require("ae_mm", Quantity::LengthMm, "radial depth of cut")?
         };
-        base.radial(ae, mode, &cutter)
+        base.radial(ae, mode, cutter)
     }
     .map_err(|e| key_err(s, e))?;
     Ok(cut)
