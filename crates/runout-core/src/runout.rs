@@ -33,7 +33,13 @@ impl Runout {
 
     /// Offset ρ (mm, ≥ 0) at angle λ (rad).
     pub fn new(offset_mm: f64, angle_rad: f64) -> Result<Self, ParamError> {
-        non_negative("runout_um", offset_mm)?;
+        if !(offset_mm.is_finite() && offset_mm >= 0.0) {
+            return Err(ParamError::new(
+                "runout_um",
+                "a finite offset >= 0 µm",
+                offset_mm * 1e3,
+            ));
+        }
         finite("runout_angle_deg", angle_rad)?;
         Ok(Runout {
             offset: offset_mm,
