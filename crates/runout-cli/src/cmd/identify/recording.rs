@@ -608,7 +608,7 @@ fn waveform_case(cutter: &Cutter, f: &FileResult) -> WaveformCase {
 }
 
 /// Full-signal fit of all recordings. Without an absolute angle, each recording's start angle is
-/// then refined against the fitted runout (±1°, coefficients re-solved linearly) and the fit
+/// first searched within ±8° without runout, then refined against the fitted runout (±1°, coefficients re-solved linearly) and the fit
 /// repeated until no start angle moves by more than 0.005° (at most 3 refits).
 fn fit_all(case: &IdentifyCase, files: &mut [FileResult]) -> Result<FullSignalFit, String> {
     let opts = FullSignalOptions {
@@ -622,6 +622,15 @@ fn fit_all(case: &IdentifyCase, files: &mut [FileResult]) -> Result<FullSignalFi
             .map(|f| waveform_case(&case.cutter, f))
             .collect::<Vec<_>>()
     };
+    // The harmonic start can be several degrees off when edge forces dominate (straight flutes):
+    // first a wide search without runout (runout modulates amplitudes, not the timing).
+    for f in files
+        .iter_mut()
+        .filter(|f| f.analysis.average.tooth_reference != ToothReference::Absolute)
+    {
+        let wc = waveform_case(&case.cutter, f);
+        f.start_angle = refine_start_angle(&wc, f.start_angle, 8f64.to_radians(), [0.0; 2], [0.0; 2]).0;
+    }
     let mut fit = full_signal_fit(&cases(files), &opts).map_err(|e| e.to_string())?;
     for _ in 0..3 {
         let e = [fit.vector[0].value, fit.vector[1].value];
