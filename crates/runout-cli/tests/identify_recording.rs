@@ -272,9 +272,47 @@ fn straight_flutes_with_strong_edge_forces_are_aligned() {
     let rec = dir.path().join("straight.txt");
     runout()
         .args([
-            "simulate", "--teeth", "4", "--diameter-mm", "10", "--rpm", "3240", "--fz-mm", "0.08", "--ap-mm", "2", "--ae-mm", "2", "--mode", "down",
-            "--runout-um", "8", "--runout-angle-deg", "-50", "--ktc", "1889.2", "--krc", "806.1", "--kac", "291", "--kte", "63.12", "--kre", "113.7",
-            "--kae", "-3.1", "--revolutions", "20", "--disks", "1", "--sample-rate-hz", "20000", "--noise-percent", "2", "--air-cut-s", "0.2",
+            "simulate",
+            "--teeth",
+            "4",
+            "--diameter-mm",
+            "10",
+            "--rpm",
+            "3240",
+            "--fz-mm",
+            "0.08",
+            "--ap-mm",
+            "2",
+            "--ae-mm",
+            "2",
+            "--mode",
+            "down",
+            "--runout-um",
+            "8",
+            "--runout-angle-deg",
+            "-50",
+            "--ktc",
+            "1889.2",
+            "--krc",
+            "806.1",
+            "--kac",
+            "291",
+            "--kte",
+            "63.12",
+            "--kre",
+            "113.7",
+            "--kae",
+            "-3.1",
+            "--revolutions",
+            "20",
+            "--disks",
+            "1",
+            "--sample-rate-hz",
+            "20000",
+            "--noise-percent",
+            "2",
+            "--air-cut-s",
+            "0.2",
             "--recording",
         ])
         .arg(&rec)
@@ -283,14 +321,42 @@ fn straight_flutes_with_strong_edge_forces_are_aligned() {
     let out = runout()
         .arg("identify")
         .arg(&rec)
-        .args(["--teeth", "4", "--diameter-mm", "10", "--rpm", "3240", "--fz-mm", "0.08", "--ap-mm", "2", "--ae-mm", "2", "--mode", "down", "--json", "-"])
+        .args([
+            "--teeth",
+            "4",
+            "--diameter-mm",
+            "10",
+            "--rpm",
+            "3240",
+            "--fz-mm",
+            "0.08",
+            "--ap-mm",
+            "2",
+            "--ae-mm",
+            "2",
+            "--mode",
+            "down",
+            "--json",
+            "-",
+        ])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let f = &v["full_signal"];
-    let (rho, lam) = (f["offset_um"].as_f64().unwrap(), f["angle_deg"].as_f64().unwrap());
-    assert!(f["r_squared"].as_f64().unwrap() > 0.99, "R² {}", f["r_squared"]);
+    let (rho, lam) = (
+        f["offset_um"].as_f64().unwrap(),
+        f["angle_deg"].as_f64().unwrap(),
+    );
+    assert!(
+        f["r_squared"].as_f64().unwrap() > 0.99,
+        "R² {}",
+        f["r_squared"]
+    );
     assert!((rho - 8.0).abs() < 0.3, "ρ {rho}");
     assert!(angle_dist(lam, -50.0, 90.0) < 3.0, "λ {lam}");
     let ktc = f["coefficients"]["ktc_N_per_mm2"].as_f64().unwrap();

@@ -154,7 +154,13 @@ fn lsq_rss<const P: usize>(rows: &[[f64; P]], y: &[f64]) -> f64 {
 /// θ₀ minimising [`residual_at`] within ±`half_width` (rad) of `start`: a 41-point grid, then a
 /// second 41-point grid over ±2 steps around the best point, then a parabola through the best
 /// point and its neighbours. Returns (θ₀, RSS).
-pub fn refine_start_angle(case: &WaveformCase, start: f64, half_width: f64, e: [f64; 2], tau: [f64; 2]) -> (f64, f64) {
+pub fn refine_start_angle(
+    case: &WaveformCase,
+    start: f64,
+    half_width: f64,
+    e: [f64; 2],
+    tau: [f64; 2],
+) -> (f64, f64) {
     const N: usize = 41;
     let (mut centre, mut width) = (start, half_width);
     let mut last = (start, f64::INFINITY, 0.0, [f64::NAN; 3]);
@@ -162,8 +168,14 @@ pub fn refine_start_angle(case: &WaveformCase, start: f64, half_width: f64, e: [
         let step = 2.0 * width / (N - 1) as f64;
         let grid: Vec<f64> = (0..N).map(|i| centre - width + step * i as f64).collect();
         let rss: Vec<f64> = grid.iter().map(|&t| residual_at(case, t, e, tau)).collect();
-        let best = (0..N).min_by(|&a, &b| rss[a].total_cmp(&rss[b])).unwrap_or(N / 2);
-        let around = if best == 0 || best == N - 1 { [f64::NAN; 3] } else { [rss[best - 1], rss[best], rss[best + 1]] };
+        let best = (0..N)
+            .min_by(|&a, &b| rss[a].total_cmp(&rss[b]))
+            .unwrap_or(N / 2);
+        let around = if best == 0 || best == N - 1 {
+            [f64::NAN; 3]
+        } else {
+            [rss[best - 1], rss[best], rss[best + 1]]
+        };
         last = (grid[best], rss[best], step, around);
         centre = grid[best];
         width = 2.0 * step;

@@ -629,7 +629,8 @@ fn fit_all(case: &IdentifyCase, files: &mut [FileResult]) -> Result<FullSignalFi
         .filter(|f| f.analysis.average.tooth_reference != ToothReference::Absolute)
     {
         let wc = waveform_case(&case.cutter, f);
-        f.start_angle = refine_start_angle(&wc, f.start_angle, 8f64.to_radians(), [0.0; 2], [0.0; 2]).0;
+        f.start_angle =
+            refine_start_angle(&wc, f.start_angle, 8f64.to_radians(), [0.0; 2], [0.0; 2]).0;
     }
     let mut fit = full_signal_fit(&cases(files), &opts).map_err(|e| e.to_string())?;
     for _ in 0..3 {
