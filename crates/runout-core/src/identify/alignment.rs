@@ -182,7 +182,7 @@ pub fn refine_start_angle(
     }
     let (t, r, step, [r0, r1, r2]) = last;
     let denom = r0 - 2.0 * r1 + r2;
-    if !(denom > 0.0) {
+    if denom.is_nan() || denom <= 0.0 {
         return (t, r);
     }
     let shift = (0.5 * (r0 - r2) / denom).clamp(-1.0, 1.0);
