@@ -781,6 +781,15 @@ fn report_json(
     })
 }
 
+/// True when every recording is a full slot (entry 0, exit π), where the mean-force calibration
+/// is unbiased by runout.
+fn slotting(case: &IdentifyCase) -> bool {
+    case.cuts.iter().all(|c| {
+        let (st, ex) = c.immersion(&case.cutter);
+        st.abs() < 1e-9 && (ex - std::f64::consts::PI).abs() < 1e-9
+    })
+}
+
 fn pm(se: Option<f64>, scale: f64, digits: usize) -> String {
     se.filter(|s| s.is_finite())
         .map_or_else(|| "(no SE)".into(), |s| format!("± {:.digits$}", s * scale))
@@ -846,8 +855,16 @@ fn print_text(
     }
     match cal {
         Ok(k) => println!(
-            "\nmean-force calibration: K_tc {:.1}, K_rc {:.1} N/mm², K_te {:.2}, K_re {:.2} N/mm",
-            k.ktc.value, k.krc.value, k.kte.value, k.kre.value
+            "\nmean-force calibration: K_tc {:.1}, K_rc {:.1} N/mm², K_te {:.2}, K_re {:.2} N/mm{}",
+            k.ktc.value,
+            k.krc.value,
+            k.kte.value,
+            k.kre.value,
+            if slotting(case) {
+                ""
+            } else {
+                "\n  (start value only: with runout at partial immersion teeth lose contact near sin φ = 0, which biases it; the full-signal fit models this)"
+            }
         ),
         Err(e) => println!("\nmean-force calibration: skipped ({e})"),
     }
