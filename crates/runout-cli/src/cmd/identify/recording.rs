@@ -462,8 +462,7 @@ fn replay_spill(
         let n = (left as usize).min(ROWS);
         r.read_exact(&mut buf[..n * c * 8])?;
         cols.iter_mut().for_each(Vec::clear);
-        for (q, row) in buf[..n * c * 8].chunks_exact(c * 8).enumerate() {
-            let _ = q;
+        for row in buf[..n * c * 8].chunks_exact(c * 8) {
             for (j, b) in row.chunks_exact(8).enumerate() {
                 cols[j].push(f64::from_le_bytes(b.try_into().unwrap_or([0; 8])));
             }
