@@ -10,7 +10,7 @@
 //! | heights | `z_<mm\|um>`, `tir_<unit>` (total indicated runout) or `runout_<unit>` (= TIR/2), optional `angle_<deg\|rad>` (direction of the runout) |
 //! | signal | `time_<s\|ms>`, one or more `disp_<name>_<unit>`, optional `pulse` (once per revolution) or `encoder_<deg\|rad>` |
 
-use crate::units::{parse_quantity, Quantity};
+use crate::units::Quantity;
 use runout_core::runout::seed::tooth_from_seed000_edge;
 use std::path::Path;
 use thiserror::Error;
@@ -130,14 +130,13 @@ impl Table {
             if unit.contains('_') {
                 continue;
             }
-            let factor =
-                parse_quantity(&format!("1{unit}"), q).map_err(|_| TableError::Header {
-                    file: self.file.clone(),
-                    message: format!(
-                        "column `{h}`: unit `{unit}` is not a unit of {q} (e.g. `{base}_{}`)",
-                        q.unit().replace('µ', "u")
-                    ),
-                })?;
+            let factor = q.unit_factor(unit).ok_or_else(|| TableError::Header {
+                file: self.file.clone(),
+                message: format!(
+                    "column `{h}`: unit `{unit}` is not a unit of {q} (e.g. `{base}_{}`)",
+                    q.unit().replace('µ', "u")
+                ),
+            })?;
             return Ok(Some(Column {
                 index,
                 name: h.clone(),
@@ -346,7 +345,7 @@ pub fn read_signal(path: &Path) -> Result<SignalTable, TableError> {
             Some((index, h, name.to_string(), unit.to_string()))
         })
         .map(|(index, h, name, unit)| {
-            let factor = parse_quantity(&format!("1{unit}"), Quantity::LengthMm).map_err(|_| TableError::Header {
+            let factor = Quantity::LengthMm.unit_factor(&unit).ok_or_else(|| TableError::Header {
                 file: t.file.clone(),
                 message: format!("column `{h}`: expected `disp_<name>_<unit>` with a length unit (um, mm), got unit `{unit}`"),
             })?;

@@ -53,7 +53,24 @@ impl Quantity {
         }
     }
 
-    /// Factor from `suffix` to the canonical unit, or `None` if the suffix is not of this quantity.
+    /// Factor from a unit `suffix` (as in a column header: `N`, `kN`, `um`) to the canonical unit;
+    /// an empty suffix means the canonical unit (as in [`parse_quantity`]); `None` when the suffix
+    /// is not a unit of this quantity.
+    ///
+    /// ```
+    /// use runout_io::units::Quantity;
+    /// assert_eq!(Quantity::ForceN.unit_factor("kN"), Some(1e3));
+    /// assert_eq!(Quantity::LengthMm.unit_factor(""), Some(1.0));
+    /// assert_eq!(Quantity::ForceN.unit_factor("V"), None);
+    /// ```
+    pub fn unit_factor(self, suffix: &str) -> Option<f64> {
+        if suffix.trim().is_empty() {
+            Some(1.0)
+        } else {
+            self.factor(suffix)
+        }
+    }
+
     fn factor(self, suffix: &str) -> Option<f64> {
         let s = suffix.trim();
         let s = s.replace('²', "2").replace(['µ', 'μ'], "u");

@@ -31,7 +31,7 @@ use runout_io::plot::identify::{
 use runout_io::recording::{
     Axis, AxisMapping, Chunk as RecChunk, ReadOptions, RecordingInfo, RecordingReader,
 };
-use runout_io::units::{parse_quantity, Quantity};
+use runout_io::units::Quantity;
 use serde_json::{json, Value as Json};
 use std::f64::consts::TAU;
 use std::fs::File;
@@ -225,7 +225,7 @@ fn force_factor(info: &RecordingInfo, channel: &str) -> Result<f64> {
         .with_context(|| format!("{}: no channel `{channel}`", info.file))?;
     match &info.channels[idx].unit {
         None => Ok(1.0),
-        Some(u) => parse_quantity(&format!("1{u}"), Quantity::ForceN).map_err(|_| {
+        Some(u) => Quantity::ForceN.unit_factor(u).ok_or_else(|| {
             anyhow::anyhow!(
                 "{}: channel `{channel}` has unit `{u}`, expected a force (N or kN)",
                 info.file
@@ -351,11 +351,8 @@ fn analyse_file(path: &Path, case: &IdentifyCase, cut: &Cut) -> Result<FileResul
 
     let avg = &analysis.average;
     let mean = |c: Component| {
-        avg.components
-            .iter()
-            .find(|x| x.component == c)
-            .map(|x| x.mean.iter().sum::<f64>() / x.mean.len().max(1) as f64)
-            .unwrap_or(0.0)
+        let m = &avg.component(c).mean;
+        m.iter().sum::<f64>() / m.len().max(1) as f64
     };
     let mean_force = [
         mean(Component::Fx),
@@ -545,15 +542,6 @@ fn default_coefficients() -> CuttingCoefficients {
     CuttingCoefficients::from_array([2000.0, 800.0, 300.0, 0.0, 0.0, 0.0])
 }
 
-fn averaged_component(an: &SignalAnalysis, c: Component) -> &[f64] {
-    an.average
-        .components
-        .iter()
-        .find(|x| x.component == c)
-        .map(|x| x.mean.as_slice())
-        .unwrap_or(&[])
-}
-
 /// Reference for the branch of the harmonic alignment: the pipeline's tooth-0 period start maps
 /// to the entry angle φ_st, which keeps its tooth numbering.
 fn branch_reference(cutter: &Cutter, f: &FileResult) -> f64 {
@@ -581,11 +569,9 @@ fn initial_start_angle(cutter: &Cutter, f: &FileResult, kc: &CuttingCoefficients
 fn waveform_case(cutter: &Cutter, f: &FileResult) -> WaveformCase {
     let avg = &f.analysis.average;
     let comp = |c: Component, axis: FitAxis| {
-        let x = avg.components.iter().find(|x| x.component == c);
-        let values = x.map(|x| x.mean.clone()).unwrap_or_default();
-        let se = x
-            .map(|x| x.se.clone())
-            .filter(|s| s.iter().all(|v| v.is_finite() && *v > 0.0));
+        let x = avg.component(c);
+        let values = x.mean.clone();
+        let se = Some(x.se.clone()).filter(|s| s.iter().all(|v| v.is_finite() && *v > 0.0));
         FitComponent { axis, values, se }
     };
     let mut components = vec![
@@ -922,9 +908,9 @@ fn write_plots(
         let deg: Vec<f64> = (0..avg.bins)
             .map(|j| (f.start_angle + TAU * j as f64 / avg.bins as f64).to_degrees())
             .collect();
-        let mx = averaged_component(&f.analysis, Component::Fx);
-        let my = averaged_component(&f.analysis, Component::Fy);
-        let mz = averaged_component(&f.analysis, Component::Fz);
+        let mx = &f.analysis.average.component(Component::Fx).mean;
+        let my = &f.analysis.average.component(Component::Fy).mean;
+        let mz = &f.analysis.average.component(Component::Fz).mean;
         let measured = [
             Curve {
                 label: "F_x (N)",
