@@ -354,9 +354,10 @@ fn sine_fit_bias_on_simulated_data() {
 fn two_teeth_helical_accuracy() {
     // K = 2, helix 30°, a_p 8 mm (helix lag 53°), down-milling a_e 2.5, ρ 10.4 µm at −131°:
     // the offset across the tooth line is seen only through the helix lag (e_x–e_y correlation
-    // 0.93). Measured over 4 noise seeds: ρ 10.06–10.36 µm (bias −0.2 µm, scatter 0.13 µm, about
-    // 3× the reported SE 0.044 µm — the model's 0.1°/disk discretisation against the 0.05°/disk
-    // truth adds scatter); λ within 0.4°. Asserted: ρ within 0.5 µm, λ within 3°.
+    // 0.93). Measured over these 4 noise seeds: ρ 10.378–10.446 µm (|error| ≤ 0.04 µm, SE 0.044
+    // µm), λ within 0.1°; with the model's disks refined to 2000 (0.03°/disk) the errors are
+    // ≤ 0.01 µm. At a_p 3 mm (20° lag) the reported SE grows to 0.25 µm and ±0.3 µm is no longer
+    // met reliably — the SE says so. Asserted: the issue's ±0.3 µm and ±3°.
     let s = Setup {
         teeth: 2,
         helix_deg: 30.0,
@@ -366,15 +367,85 @@ fn two_teeth_helical_accuracy() {
         rho_um: 10.407596637935521,
         lambda_deg: -130.89042971636746,
     };
-    for seed in [414u64, 2] {
+    for seed in [414u64, 2, 3, 4] {
         let (case, _) = recording(&s, 0.07, kc(), seed);
         let fit = full_signal_fit(&[case], &FullSignalOptions::default()).unwrap();
         assert!(
-            (fit.offset.value * 1e3 - s.rho_um).abs() < 0.5,
-            "{:?}",
+            (fit.offset.value * 1e3 - s.rho_um).abs() <= 0.3,
+            "seed {seed}: {:?}",
             fit.offset
         );
-        assert!(angle_diff_deg(fit.angle.value.to_degrees(), s.lambda_deg) < 3.0);
+        assert!(angle_diff_deg(fit.angle.value.to_degrees(), s.lambda_deg) <= 3.0);
+    }
+}
+
+/// Noise-free forces of a straight-fluted K = 2 cutter whose tooth 1 trails tooth 0 by π − 2δ.
+fn two_teeth_straight_forces(s: &Setup, fz: f64, delta: f64) -> ForceSeries {
+    use std::f64::consts::PI;
+    let pitch = vec![PI - 2.0 * delta, PI + 2.0 * delta];
+    let cutter = Cutter::new(10.0, pitch, 0.0, f64::INFINITY, RadiusProfile::Flat).unwrap();
+    let runout = Runout::new(s.rho_um * 1e-3, s.lambda_deg.to_radians()).unwrap();
+    let cut = Cut::new(3000.0, fz, s.ap_mm)
+        .unwrap()
+        .radial(s.ae_mm, s.mode, &cutter)
+        .unwrap();
+    let chip = ArcChip::new(&cutter, &runout, fz).unwrap();
+    let model = ForceModel {
+        cutter,
+        runout,
+        cut,
+        coefficients: kc(),
+    };
+    model.simulate(&chip, &Sampling::new(1.0, 1.0, 1).unwrap())
+}
+
+#[test]
+fn two_teeth_straight_flutes_offset_across_the_tooth_line_is_below_the_noise_bound() {
+    // Why the issue's ±0.3 µm cannot be met for K = 2 with straight flutes, by any method.
+    // The component ρ⊥ of the offset across the tooth line changes the radii only at second order
+    // (ρ²/2R ≈ 0.01 µm) and otherwise only turns the two cutting points by ±δ, δ = ρ⊥/R (0.0115°
+    // per µm at R = 5 mm). A common turn is indistinguishable from the spindle-angle origin, so
+    // what is left is a pitch change of 2δ. Its Fisher information at the issue's conditions
+    // (σ = 2 % of each component's peak, 20 revolutions averaged, 1° samples) bounds the standard
+    // error of any unbiased estimate of ρ⊥ from below — here even with every other parameter
+    // known (nuisance parameters only raise the bound). The bound is computed by finite difference
+    // of the simulated waveform (linear in δ at this size: the chip changes by f_z·2δ/π).
+    let s = Setup {
+        teeth: 2,
+        helix_deg: 0.0,
+        mode: MillingMode::Down,
+        ae_mm: 3.0,
+        ap_mm: 1.0,
+        rho_um: 10.0 * 50f64.to_radians().cos(),
+        lambda_deg: 0.0,
+    };
+    for (mode, ae_mm) in [
+        (MillingMode::Down, 3.0),
+        (MillingMode::Up, 2.0),
+        (MillingMode::Down, 10.0),
+    ] {
+        let s = Setup { mode, ae_mm, ..s };
+        let fz = 0.08;
+        let perp_um = 1.0;
+        let a = two_teeth_straight_forces(&s, fz, 0.0);
+        let b = two_teeth_straight_forces(&s, fz, perp_um * 1e-3 / 5.0);
+        let mut info = 0.0;
+        for (x, y) in [(&a.fx, &b.fx), (&a.fy, &b.fy), (&a.fz, &b.fz)] {
+            let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let sigma = 0.02 * peak / 20f64.sqrt();
+            info += x
+                .iter()
+                .zip(y.iter())
+                .map(|(p, q)| ((p - q) / perp_um / sigma).powi(2))
+                .sum::<f64>();
+        }
+        let bound_um = 1.0 / info.sqrt();
+        // measured: 0.77 µm (down a_e 3), 0.88 µm (up a_e 2), 0.79 µm (slot)
+        assert!(
+            bound_um > 0.6,
+            "{mode:?} a_e {ae_mm}: Cramér–Rao bound on ρ⊥ only {bound_um:.3} µm"
+        );
+        println!("{mode:?} a_e {ae_mm}: SE(ρ⊥) ≥ {bound_um:.2} µm (issue tolerance 0.3 µm)");
     }
 }
 
