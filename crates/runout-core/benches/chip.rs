@@ -1,6 +1,7 @@
 //! IUCT model throughput (points/s, one thread): exact (Newton, methods.md eq. 2.2–2.3) vs
-//! equivalent (eq. 2.8) vs arc (eq. 2.5), on the general 3-D kinematics and on the 3-axis trait
-//! path used by the force simulation. Cases: R 5, K 4, helix 30°, f_z 0.1, ρ 10 µm (methods.md
+//! equivalent (eq. 2.8; bulk Hermite look-back of `chip::lookback`, and the direct per-point
+//! evaluation) vs arc (eq. 2.5), on the general 3-D kinematics and on the 3-axis trait path used
+//! by the force simulation. Cases: R 5, K 4, helix 30°, f_z 0.1, ρ 10 µm (methods.md
 //! §2.5) in straight feed and with a 60°/s swing about y.
 //!
 //! Two measurements: criterion's wall time, and a final summary with the thread's CPU time read
@@ -11,7 +12,8 @@
 use criterion::measurement::{Measurement, WallTime};
 use criterion::{BenchmarkGroup, Criterion, Throughput};
 use runout_core::chip::compare::{
-    arc_values, equivalent_values, exact_values, sample_grid, Motion, SamplePoint,
+    arc_values, equivalent_values, equivalent_values_direct, exact_values, sample_grid, Motion,
+    SamplePoint,
 };
 use runout_core::chip::kinematics::small_sin_cos;
 use runout_core::chip::*;
@@ -66,8 +68,27 @@ fn swing() -> Motion {
     )
 }
 
+/// A flank-milling-like CL path: a point every 1 mm along x (0.4 mm of feed per revolution, so
+/// 40 % of the look-back windows span a junction), the axis leaning 0.5° more per point about
+/// alternating directions.
+fn cl_path() -> Motion {
+    let pts: Vec<ClPoint> = (0..40)
+        .map(|n| {
+            let a = (0.5 * n as f64).to_radians();
+            let b = if n % 2 == 0 { 0.0 } else { 0.3f64.to_radians() };
+            ClPoint {
+                p: Vec3::new(n as f64 - 10.0, 0.02 * (n as f64).powi(2), 0.0),
+                u: Vec3::new(a.sin(), b.sin(), a.cos() * b.cos()).normalize(),
+                feed: 40.0,
+            }
+        })
+        .collect();
+    Motion::Path(ClPath::new(&pts).unwrap())
+}
+
 fn points() -> Vec<SamplePoint> {
-    sample_grid(4, &[0.0, 5.0, 10.0], 0.01, 0.01, 360)
+    // 25 revolutions from t = 0.01 s: covers 10 mm of the CL path (10 junctions)
+    sample_grid(4, &[0.0, 5.0, 10.0], 0.01, 0.25, 360)
 }
 
 fn general<T: Measurement>(c: &mut Criterion<T>, name: &str, kin: &ToolKinematics<Motion>) {
@@ -78,6 +99,9 @@ fn general<T: Measurement>(c: &mut Criterion<T>, name: &str, kin: &ToolKinematic
     g.bench_function("exact", |b| b.iter(|| exact_values(kin, black_box(&pts))));
     g.bench_function("equivalent", |b| {
         b.iter(|| equivalent_values(kin, black_box(&pts), &params))
+    });
+    g.bench_function("equivalent_direct", |b| {
+        b.iter(|| equivalent_values_direct(kin, black_box(&pts), &params))
     });
     g.bench_function("arc", |b| b.iter(|| arc_values(kin, black_box(&pts))));
     g.finish();
@@ -121,6 +145,7 @@ fn trait_models() -> (ExactChip, EquivalentChip, ArcChip) {
 fn all<T: Measurement>(c: &mut Criterion<T>, tag: &str) {
     general(c, &format!("chip_3axis_{tag}"), &kin(straight()));
     general(c, &format!("chip_5axis_swing_{tag}"), &kin(swing()));
+    general(c, &format!("chip_5axis_cl_path_{tag}"), &kin(cl_path()));
     let (e, q, a) = trait_models();
     let mut g = c.benchmark_group(format!("chip_trait_3axis_{tag}"));
     g.throughput(Throughput::Elements(4 * phis().len() as u64));
@@ -162,15 +187,22 @@ fn summary() {
     );
     let pts = points();
     let params = EquivalentParams::default();
-    for (name, k) in [("3-axis", kin(straight())), ("5-axis swing", kin(swing()))] {
+    for (name, k) in [
+        ("3-axis", kin(straight())),
+        ("5-axis swing", kin(swing())),
+        ("5-axis CL path", kin(cl_path())),
+    ] {
         let ex = rate(pts.len(), || exact_values(&k, &pts).iter().sum());
         let eq = rate(pts.len(), || {
             equivalent_values(&k, &pts, &params).iter().sum()
         });
+        let dir = rate(pts.len(), || {
+            equivalent_values_direct(&k, &pts, &params).iter().sum()
+        });
         let ar = rate(pts.len(), || arc_values(&k, &pts).iter().sum());
         println!(
-            "{name:>13} general: exact {:.3e}  equivalent {:.3e} ({:.1}× exact)  arc {:.3e} ({:.1}× exact)",
-            ex, eq, eq / ex, ar, ar / ex
+            "{name:>14} general: exact {:.3e}  equivalent {:.3e} ({:.1}× exact; direct per point {:.3e}, {:.1}×)  arc {:.3e} ({:.1}× exact)",
+            ex, eq, eq / ex, dir, dir / ex, ar, ar / ex
         );
     }
     let (e, q, a) = trait_models();

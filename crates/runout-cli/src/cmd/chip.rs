@@ -10,8 +10,8 @@ use runout_core::chip::compare::{
     ModelValues, SamplePoint,
 };
 use runout_core::chip::{
-    arc_at, calibration_grid, closed_forms_at, equivalent_at, exact_at, fit_compensation,
-    EquivalentParams, NewtonOptions, ToolMotion,
+    arc_at, calibration_grid, closed_forms_at, exact_at, fit_compensation, EquivalentParams,
+    NewtonOptions, ToolMotion,
 };
 use runout_io::config::chip::{read_cases, ChipCase};
 use runout_io::plot::chip::{chip_angle_plot, chip_map_plot, ChipMap, ToothCurve};
@@ -353,6 +353,10 @@ fn print_compare(
 fn eval_model(case: &ChipCase, model: &str) -> Result<Vec<f64>> {
     let kin = &case.kin;
     let params = EquivalentParams::default();
+    if model == "equivalent" {
+        // the bulk evaluator (one look-back per time, shared by teeth and heights)
+        return Ok(equivalent_values(kin, &case.points, &params));
+    }
     let opts = NewtonOptions::default();
     let mut geo: Option<runout_core::chip::HeightGeometry> = None;
     let mut out = Vec::with_capacity(case.points.len());
@@ -374,7 +378,6 @@ fn eval_model(case: &ChipCase, model: &str) -> Result<Vec<f64>> {
                 }
                 e.raw
             }
-            "equivalent" => equivalent_at(kin, g, q.tooth, q.t, &params),
             "arc" => arc_at(kin, g, q.tooth, q.t),
             "circle" => closed_forms_at(kin, g, q.tooth, q.t, &params).circle,
             other => bail!("--model: expected exact, equivalent, arc or circle, got `{other}`"),

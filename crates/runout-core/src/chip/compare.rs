@@ -10,6 +10,7 @@ use super::kinematics::{
     CircularFeed, ClPath, ConstantSwing, HeightGeometry, JointPath, Pose, StraightFeed,
     ToolKinematics, ToolMotion,
 };
+use super::lookback::EquivalentEvaluator;
 
 /// Any of the supported tool motions (one type, so a case set can mix them).
 #[derive(Debug, Clone, PartialEq)]
@@ -35,6 +36,15 @@ impl ToolMotion for Motion {
             Motion::Swing(m) => m.pose(t),
             Motion::Path(m) => m.pose(t),
             Motion::Joints(m) => m.pose(t),
+        }
+    }
+    fn smooth_on(&self, t0: f64, t1: f64) -> bool {
+        match self {
+            Motion::Straight(m) => m.smooth_on(t0, t1),
+            Motion::Circular(m) => m.smooth_on(t0, t1),
+            Motion::Swing(m) => m.smooth_on(t0, t1),
+            Motion::Path(m) => m.smooth_on(t0, t1),
+            Motion::Joints(m) => m.smooth_on(t0, t1),
         }
     }
 }
@@ -91,20 +101,30 @@ struct Heights(Vec<HeightGeometry>);
 
 impl Heights {
     fn new<M: ToolMotion>(kin: &ToolKinematics<M>, points: &[SamplePoint]) -> Self {
-        let mut v: Vec<HeightGeometry> = Vec::new();
-        for q in points {
-            if !v.iter().any(|g| g.z == q.z) {
-                v.push(kin.at_height(q.z));
-            }
-        }
-        Heights(v)
+        Heights(
+            distinct_heights(points)
+                .iter()
+                .map(|&z| kin.at_height(z))
+                .collect(),
+        )
     }
     fn get(&self, z: f64) -> &HeightGeometry {
         self.0.iter().find(|g| g.z == z).expect("prepared")
     }
 }
 
-/// Evaluate all models at `points`.
+/// The distinct heights of `points`, in order of first appearance.
+fn distinct_heights(points: &[SamplePoint]) -> Vec<f64> {
+    let mut v: Vec<f64> = Vec::new();
+    for q in points {
+        if !v.contains(&q.z) {
+            v.push(q.z);
+        }
+    }
+    v
+}
+
+/// Evaluate all models at `points` (the equivalent model by [`equivalent_values`]).
 pub fn evaluate_models<M: ToolMotion>(
     kin: &ToolKinematics<M>,
     points: &[SamplePoint],
@@ -112,7 +132,10 @@ pub fn evaluate_models<M: ToolMotion>(
 ) -> ModelValues {
     let opts = NewtonOptions::default();
     let heights = Heights::new(kin, points);
-    let mut v = ModelValues::default();
+    let mut v = ModelValues {
+        equivalent: equivalent_values(kin, points, params),
+        ..Default::default()
+    };
     for q in points {
         let geo = heights.get(q.z);
         let e = exact_at(kin, geo, q.tooth, q.t, &opts);
@@ -121,7 +144,6 @@ pub fn evaluate_models<M: ToolMotion>(
         let c = closed_forms_at(kin, geo, q.tooth, q.t, params);
         v.arc.push(c.arc.max(0.0));
         v.circle.push(c.circle.max(0.0));
-        v.equivalent.push(c.equivalent.max(0.0));
     }
     v
 }
@@ -136,8 +158,43 @@ pub fn exact_values<M: ToolMotion>(kin: &ToolKinematics<M>, points: &[SamplePoin
         .collect()
 }
 
-/// Equivalent h only (for throughput measurement).
+/// Equivalent h (mm, ≥ 0) at `points` by the bulk [`EquivalentEvaluator`]: one look-back window
+/// per run of consecutive points with the same time, shared by their teeth and heights.
 pub fn equivalent_values<M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    points: &[SamplePoint],
+    params: &EquivalentParams,
+) -> Vec<f64> {
+    // one pass: the distinct heights and each point's index among them
+    let mut zs: Vec<f64> = Vec::new();
+    let index: Vec<usize> = points
+        .iter()
+        .map(|q| {
+            zs.iter().position(|&z| z == q.z).unwrap_or_else(|| {
+                zs.push(q.z);
+                zs.len() - 1
+            })
+        })
+        .collect();
+    let eval = EquivalentEvaluator::new(kin, &zs, *params);
+    let mut out = Vec::with_capacity(points.len());
+    let mut start = 0;
+    for run in points.chunk_by(|a, b| a.t == b.t) {
+        let window = eval.look_back(run[0].t);
+        let heights = &index[start..start + run.len()];
+        out.extend(
+            run.iter()
+                .zip(heights)
+                .map(|(q, &height)| eval.raw(&window, height, q.tooth).max(0.0)),
+        );
+        start += run.len();
+    }
+    out
+}
+
+/// Equivalent h by the direct per-point evaluation [`equivalent_at`] (K + 1 poses per point):
+/// the reference for [`equivalent_values`].
+pub fn equivalent_values_direct<M: ToolMotion>(
     kin: &ToolKinematics<M>,
     points: &[SamplePoint],
     params: &EquivalentParams,

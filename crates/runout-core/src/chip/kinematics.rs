@@ -40,6 +40,14 @@ pub trait ToolMotion: Send + Sync {
     /// Pose at time `t` (s). Must be defined for all t (extrapolate outside a path) because the
     /// chip thickness looks back by up to one revolution.
     fn pose(&self, t: f64) -> Pose;
+
+    /// Whether the pose is an analytic function of time on all of [t0, t1] (no junction of
+    /// segments inside), so that bulk evaluators may interpolate it there
+    /// ([`super::EquivalentEvaluator`]). The default `false` makes them evaluate the motion
+    /// directly.
+    fn smooth_on(&self, _t0: f64, _t1: f64) -> bool {
+        false
+    }
 }
 
 /// Rodrigues rotation of `v` about unit axis `w` by the angle with sine `s` and cosine `c`.
@@ -87,6 +95,9 @@ impl StraightFeed {
 }
 
 impl ToolMotion for StraightFeed {
+    fn smooth_on(&self, _t0: f64, _t1: f64) -> bool {
+        true
+    }
     #[inline]
     fn pose(&self, t: f64) -> Pose {
         Pose {
@@ -135,6 +146,9 @@ impl CircularFeed {
 }
 
 impl ToolMotion for CircularFeed {
+    fn smooth_on(&self, _t0: f64, _t1: f64) -> bool {
+        true
+    }
     #[inline]
     fn pose(&self, t: f64) -> Pose {
         let (s, c) = (self.start_angle + self.rate * t).sin_cos();
@@ -196,6 +210,9 @@ impl ConstantSwing {
 }
 
 impl ToolMotion for ConstantSwing {
+    fn smooth_on(&self, _t0: f64, _t1: f64) -> bool {
+        true
+    }
     #[inline]
     fn pose(&self, t: f64) -> Pose {
         let (s, c) = (self.rate * t).sin_cos();
@@ -358,13 +375,22 @@ impl ClPath {
         self.segments.is_empty()
     }
 
+    /// Index of the segment whose formula applies at `t` (the first/last one outside the path).
+    fn segment_index(&self, t: f64) -> usize {
+        self.segments
+            .partition_point(|s| s.t0 <= t)
+            .saturating_sub(1)
+    }
+
     fn find(&self, t: f64) -> &Segment {
-        let idx = self.segments.partition_point(|s| s.t0 <= t);
-        &self.segments[idx.saturating_sub(1)]
+        &self.segments[self.segment_index(t)]
     }
 }
 
 impl ToolMotion for ClPath {
+    fn smooth_on(&self, t0: f64, t1: f64) -> bool {
+        self.segment_index(t0) == self.segment_index(t1)
+    }
     fn pose(&self, t: f64) -> Pose {
         let seg = self.find(t);
         let s = (t - seg.t0) / seg.dt;
@@ -459,13 +485,23 @@ impl JointPath {
     }
 }
 
-impl ToolMotion for JointPath {
-    fn pose(&self, t: f64) -> Pose {
-        let n = self
-            .times
+impl JointPath {
+    /// Index of the block interval whose interpolation applies at `t` (clamped outside).
+    fn block_index(&self, t: f64) -> usize {
+        self.times
             .partition_point(|&s| s <= t)
             .clamp(1, self.points.len() - 1)
-            - 1;
+            - 1
+    }
+}
+
+impl ToolMotion for JointPath {
+    fn smooth_on(&self, t0: f64, t1: f64) -> bool {
+        self.block_index(t0) == self.block_index(t1)
+    }
+
+    fn pose(&self, t: f64) -> Pose {
+        let n = self.block_index(t);
         let (p0, p1) = (&self.points[n], &self.points[n + 1]);
         let dt = self.times[n + 1] - self.times[n];
         let s = (t - self.times[n]) / dt;

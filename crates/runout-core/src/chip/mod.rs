@@ -11,6 +11,7 @@ pub mod compare;
 pub mod compensation;
 pub mod exact;
 pub mod kinematics;
+pub mod lookback;
 mod straight;
 
 pub use arc::{ArcAtHeight, ArcChip};
@@ -28,6 +29,7 @@ pub use kinematics::{
     CircularFeed, ClPath, ClPoint, ConstantSwing, EdgeState, HeightGeometry, JointPath, JointPoint,
     Pose, SpindlePoint, SpindleSense, StraightFeed, ToolKinematics, ToolMotion, Vec3,
 };
+pub use lookback::{EquivalentEvaluator, LookBack};
 pub use straight::{
     straight_feed_kinematics, EquivalentAtHeight, EquivalentChip, ExactAtHeight, ExactChip,
 };
