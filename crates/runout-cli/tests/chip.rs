@@ -1,19 +1,13 @@
 //! `runout chip compare` / `runout chip eval` and `runout simulate --chip-model` end to end.
 
-use assert_cmd::Command;
 use std::fs;
 use std::path::PathBuf;
 
-fn runout() -> Command {
-    let mut c = Command::cargo_bin("runout").unwrap();
-    c.env("RUST_BACKTRACE", "0");
-    c
-}
+mod common;
+use common::*;
 
-fn example(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/chip")
-        .join(name)
+fn chip_example(name: &str) -> PathBuf {
+    example(&format!("chip/{name}"))
 }
 
 fn json_of(out: &[u8]) -> serde_json::Value {
@@ -24,7 +18,7 @@ fn json_of(out: &[u8]) -> serde_json::Value {
 fn compare_shipped_case_set_meets_accuracy_target() {
     let out = runout()
         .args(["chip", "compare"])
-        .arg(example("section2_5.toml"))
+        .arg(chip_example("section2_5.toml"))
         .args(["--json", "-"])
         .output()
         .unwrap();
@@ -53,7 +47,7 @@ fn compare_shipped_case_set_meets_accuracy_target() {
 fn compare_text_states_both_metrics_and_fit() {
     let out = runout()
         .args(["chip", "compare"])
-        .arg(example("section2_5.toml"))
+        .arg(chip_example("section2_5.toml"))
         .args(["--case", "K3", "--fit-k"])
         .output()
         .unwrap();
@@ -75,7 +69,7 @@ fn eval_path_writes_csv_plots_and_json() {
     let map = dir.path().join("map.png");
     let out = runout()
         .args(["chip", "eval"])
-        .arg(example("flank_path.toml"))
+        .arg(chip_example("flank_path.toml"))
         .args(["--model", "equivalent", "--out"])
         .arg(&csv)
         .arg("--plot")
@@ -114,7 +108,7 @@ fn eval_path_writes_csv_plots_and_json() {
 fn eval_rejects_unknown_model_and_bad_height() {
     let out = runout()
         .args(["chip", "eval"])
-        .arg(example("section2_5.toml"))
+        .arg(chip_example("section2_5.toml"))
         .args(["--model", "magic"])
         .output()
         .unwrap();
@@ -123,7 +117,7 @@ fn eval_rejects_unknown_model_and_bad_height() {
     let dir = tempfile::tempdir().unwrap();
     let out = runout()
         .args(["chip", "eval"])
-        .arg(example("section2_5.toml"))
+        .arg(chip_example("section2_5.toml"))
         .arg("--plot")
         .arg(dir.path().join("p.svg"))
         .args(["--plot-height-mm", "3.3"])
@@ -174,45 +168,23 @@ fn bad_case_files_name_file_case_and_key() {
 #[test]
 fn simulate_with_every_chip_model() {
     let base = [
-        "simulate",
-        "--teeth",
-        "4",
-        "--diameter-mm",
-        "10",
-        "--rpm",
-        "3240",
-        "--fz-mm",
-        "0.08",
-        "--ap-mm",
-        "1",
-        "--ae-mm",
-        "2",
-        "--mode",
-        "down",
-        "--ktc",
-        "1889.2",
-        "--krc",
-        "806.1",
-        "--kac",
-        "291",
-        "--kte",
-        "63.12",
-        "--kre",
-        "113.7",
-        "--kae",
-        "-3.1",
-        "--runout-um",
-        "8",
-        "--step-deg",
-        "0.25",
-        "--revolutions",
-        "1",
-        "--json",
-        "-",
-    ];
+        &SEED003_CUT[..],
+        &SEED003_COEFFICIENTS,
+        &[
+            "--runout-um",
+            "8",
+            "--step-deg",
+            "0.25",
+            "--revolutions",
+            "1",
+            "--json",
+            "-",
+        ],
+    ]
+    .concat();
     let peak = |model: &str| {
         let out = runout()
-            .args(base)
+            .args(&base)
             .args(["--chip-model", model])
             .output()
             .unwrap();
@@ -235,7 +207,7 @@ fn simulate_with_every_chip_model() {
     assert!((e - a).abs() / a < 0.02, "{e} {a}");
     assert!((q - e).abs() / e < 1e-3, "{q} {e}");
     let out = runout()
-        .args(base)
+        .args(&base)
         .args(["--chip-model", "trochoid"])
         .output()
         .unwrap();
@@ -248,7 +220,7 @@ fn simulate_with_every_chip_model() {
 fn compare_machine_without_rtcp() {
     let out = runout()
         .args(["chip", "compare"])
-        .arg(example("joints_no_rtcp.toml"))
+        .arg(chip_example("joints_no_rtcp.toml"))
         .args(["--json", "-"])
         .output()
         .unwrap();

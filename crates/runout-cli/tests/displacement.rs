@@ -1,15 +1,11 @@
 //! `runout displacement …` end to end: JSON fields with units, text, plots, and clear errors.
 
-use assert_cmd::Command;
 use std::f64::consts::{PI, TAU};
 use std::fs;
 use std::path::{Path, PathBuf};
 
-fn runout() -> Command {
-    let mut c = Command::cargo_bin("runout").unwrap();
-    c.env("RUST_BACKTRACE", "0");
-    c
-}
+mod common;
+use common::*;
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);

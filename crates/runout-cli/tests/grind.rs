@@ -1,17 +1,10 @@
 //! `runout grind compensate` end to end on the shipped example (examples/grind).
 
-use assert_cmd::Command;
-use std::path::PathBuf;
-
-fn runout() -> Command {
-    let mut c = Command::cargo_bin("runout").unwrap();
-    c.env("RUST_BACKTRACE", "0");
-    c
-}
+mod common;
+use common::*;
 
 fn ex(name: &str) -> String {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/grind");
-    root.join(name).display().to_string()
+    example(&format!("grind/{name}")).display().to_string()
 }
 
 fn base() -> Vec<String> {

@@ -1,18 +1,12 @@
 //! `runout identify RECORDING…` end to end on the bundled example and on generated recordings.
 
-use assert_cmd::Command;
 use std::path::{Path, PathBuf};
 
-fn runout() -> Command {
-    let mut c = Command::cargo_bin("runout").unwrap();
-    c.env("RUST_BACKTRACE", "0");
-    c
-}
+mod common;
+use common::*;
 
-fn example(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/identify")
-        .join(name)
+fn identify_example(name: &str) -> PathBuf {
+    example(&format!("identify/{name}"))
 }
 
 /// Smallest angular distance (deg) between `a` and `b` modulo `period`.
@@ -26,9 +20,12 @@ fn bundled_example_recovers_the_known_runout_and_coefficients() {
     let dir = tempfile::tempdir().unwrap();
     let out = runout()
         .arg("identify")
-        .args([example("cut_fz0.05.txt"), example("cut_fz0.08.txt")])
+        .args([
+            identify_example("cut_fz0.05.txt"),
+            identify_example("cut_fz0.08.txt"),
+        ])
         .arg("--config")
-        .arg(example("cut.toml"))
+        .arg(identify_example("cut.toml"))
         .args(["--json", "-", "--plot-dir"])
         .arg(dir.path())
         .output()
@@ -291,18 +288,9 @@ fn straight_flutes_with_strong_edge_forces_are_aligned() {
             "8",
             "--runout-angle-deg",
             "-50",
-            "--ktc",
-            "1889.2",
-            "--krc",
-            "806.1",
-            "--kac",
-            "291",
-            "--kte",
-            "63.12",
-            "--kre",
-            "113.7",
-            "--kae",
-            "-3.1",
+        ])
+        .args(SEED003_COEFFICIENTS)
+        .args([
             "--revolutions",
             "20",
             "--disks",

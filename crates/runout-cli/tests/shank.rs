@@ -1,18 +1,14 @@
 //! `runout shank` end to end: stiffness worked examples, force + runout + validation on a
 //! synthetic recording (CSV and DynoWare), binary output, and clear errors for bad inputs.
 
-use assert_cmd::Command;
 use runout_core::shank::{ShankBeam, SyntheticShank};
 use runout_core::*;
 use runout_io::export::{write_dynoware, Channel, TextStyle};
 use std::fs;
 use std::path::{Path, PathBuf};
 
-fn runout() -> Command {
-    let mut c = Command::cargo_bin("runout").unwrap();
-    c.env("RUST_BACKTRACE", "0");
-    c
-}
+mod common;
+use common::*;
 
 fn stiffness_json(args: &[&str]) -> serde_json::Value {
     let out = runout()

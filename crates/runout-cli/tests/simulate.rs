@@ -1,48 +1,15 @@
 //! `runout simulate` end to end: outputs, units in names, and clear errors for bad configs.
 
-use assert_cmd::Command;
 use std::fs;
 
-fn runout() -> Command {
-    let mut c = Command::cargo_bin("runout").unwrap();
-    c.env("RUST_BACKTRACE", "0");
-    c
-}
-
-const REF: &[&str] = &[
-    "simulate",
-    "--teeth",
-    "4",
-    "--diameter-mm",
-    "10",
-    "--rpm",
-    "3240",
-    "--fz-mm",
-    "0.08",
-    "--ap-mm",
-    "1",
-    "--ae-mm",
-    "2",
-    "--mode",
-    "down",
-    "--ktc",
-    "1889.2",
-    "--krc",
-    "806.1",
-    "--kac",
-    "291",
-    "--kte",
-    "63.12",
-    "--kre",
-    "113.7",
-    "--kae",
-    "-3.1",
-];
+mod common;
+use common::*;
 
 #[test]
 fn flags_alone_give_reference_peak_in_json() {
     let out = runout()
-        .args(REF)
+        .args(SEED003_CUT)
+        .args(SEED003_COEFFICIENTS)
         .args(["--step-deg", "0.01", "--revolutions", "1", "--json", "-"])
         .output()
         .unwrap();

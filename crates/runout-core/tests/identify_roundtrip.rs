@@ -211,10 +211,9 @@ fn round_trip_representative_cases() {
     }
 }
 
-#[test]
-fn two_teeth_straight_flutes_report_partial_observability() {
-    // K = 2, straight flutes: only ρ·cos(λ − ψ₀) (along the tooth line) is observable.
-    let s = Setup {
+/// K = 2, straight flutes, down-milling a_e 3, a_p 1, ρ 10 µm at 50°.
+fn two_teeth_straight() -> Setup {
+    Setup {
         teeth: 2,
         helix_deg: 0.0,
         mode: MillingMode::Down,
@@ -222,7 +221,13 @@ fn two_teeth_straight_flutes_report_partial_observability() {
         ap_mm: 1.0,
         rho_um: 10.0,
         lambda_deg: 50.0,
-    };
+    }
+}
+
+#[test]
+fn two_teeth_straight_flutes_report_partial_observability() {
+    // K = 2, straight flutes: only ρ·cos(λ − ψ₀) (along the tooth line) is observable.
+    let s = two_teeth_straight();
     let (case, _) = recording(&s, 0.08, kc(), 7);
     let fit = full_signal_fit(&[case], &FullSignalOptions::default()).unwrap();
     match fit.observability {
@@ -410,14 +415,11 @@ fn two_teeth_straight_flutes_offset_across_the_tooth_line_is_below_the_noise_bou
     // error of any unbiased estimate of ρ⊥ from below — here even with every other parameter
     // known (nuisance parameters only raise the bound). The bound is computed by finite difference
     // of the simulated waveform (linear in δ at this size: the chip changes by f_z·2δ/π).
+    // the offset along the tooth line of two_teeth_straight(): ρ cos λ = 6.43 µm
     let s = Setup {
-        teeth: 2,
-        helix_deg: 0.0,
-        mode: MillingMode::Down,
-        ae_mm: 3.0,
-        ap_mm: 1.0,
         rho_um: 10.0 * 50f64.to_radians().cos(),
         lambda_deg: 0.0,
+        ..two_teeth_straight()
     };
     for (mode, ae_mm) in [
         (MillingMode::Down, 3.0),
