@@ -308,6 +308,89 @@ pub fn parse_apt(file: &str, text: &str) -> Result<Toolpath, ToolpathError> {
     Ok(apt.path)
 }
 
+/// One data row of a numeric toolpath CSV.
+struct NumericRow {
+    /// 1-based line number.
+    line: usize,
+    /// The required values (all columns of the header but the trailing feed), finite.
+    values: Vec<f64>,
+    /// The optional trailing feed (mm/min, > 0).
+    feed_mm_min: Option<f64>,
+}
+
+/// Rows of a comma-separated numeric table whose last column (`feed_mm_min`) is optional:
+/// `#` starts a comment, blank lines are skipped, a text first row must be `header` (case
+/// insensitive, with or without the feed column). Errors name the file, line and field.
+fn numeric_rows(file: &str, text: &str, header: &[&str]) -> Result<Vec<NumericRow>, ToolpathError> {
+    let err = |line: usize, message: String| ToolpathError::Parse {
+        file: file.into(),
+        line,
+        message,
+    };
+    let full = header.len();
+    let counts = full - 1..=full;
+    let mut rows: Vec<NumericRow> = Vec::new();
+    for (idx, raw) in text.lines().enumerate() {
+        let line = idx + 1;
+        let body = raw.split('#').next().unwrap_or("").trim();
+        if body.is_empty() {
+            continue;
+        }
+        let fields: Vec<&str> = body.split(',').map(str::trim).collect();
+        if rows.is_empty() && fields[0].parse::<f64>().is_err() {
+            let ok = counts.contains(&fields.len())
+                && fields
+                    .iter()
+                    .zip(header)
+                    .all(|(f, h)| f.eq_ignore_ascii_case(h));
+            if !ok {
+                return Err(err(
+                    line,
+                    format!("header `{body}`: expected {}", header.join(",")),
+                ));
+            }
+            continue;
+        }
+        if !counts.contains(&fields.len()) {
+            return Err(err(
+                line,
+                format!(
+                    "expected {} or {full} fields ({}[,{}]), got {}",
+                    full - 1,
+                    header[..full - 1].join(","),
+                    header[full - 1],
+                    fields.len()
+                ),
+            ));
+        }
+        let mut values = fields
+            .iter()
+            .enumerate()
+            .map(|(q, f)| {
+                f.parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| err(line, format!("field {} (`{f}`) is not a number", q + 1)))
+            })
+            .collect::<Result<Vec<f64>, _>>()?;
+        let feed_mm_min = if values.len() == full {
+            let f = values.pop().expect("full row");
+            if f <= 0.0 {
+                return Err(err(line, format!("feed_mm_min must be > 0, got {f}")));
+            }
+            Some(f)
+        } else {
+            None
+        };
+        rows.push(NumericRow {
+            line,
+            values,
+            feed_mm_min,
+        });
+    }
+    Ok(rows)
+}
+
 /// Parse CSV `x_mm,y_mm,z_mm,i,j,k[,feed_mm_min]`; an optional first header line is checked.
 ///
 /// ```
@@ -319,65 +402,18 @@ pub fn parse_apt(file: &str, text: &str) -> Result<Toolpath, ToolpathError> {
 pub fn parse_cl_csv(file: &str, text: &str) -> Result<Toolpath, ToolpathError> {
     const HEADER: [&str; 7] = ["x_mm", "y_mm", "z_mm", "i", "j", "k", "feed_mm_min"];
     let mut path = Toolpath::default();
-    let err = |line: usize, message: String| ToolpathError::Parse {
-        file: file.into(),
-        line,
-        message,
-    };
-    for (idx, raw) in text.lines().enumerate() {
-        let line = idx + 1;
-        let body = raw.split('#').next().unwrap_or("").trim();
-        if body.is_empty() {
-            continue;
-        }
-        let fields: Vec<&str> = body.split(',').map(str::trim).collect();
-        let first_is_text = fields[0].parse::<f64>().is_err();
-        if path.points.is_empty() && first_is_text {
-            let ok = (6..=7).contains(&fields.len())
-                && fields
-                    .iter()
-                    .zip(HEADER)
-                    .all(|(f, h)| f.eq_ignore_ascii_case(h));
-            if !ok {
-                return Err(err(
-                    line,
-                    format!("header `{body}`: expected {}", HEADER.join(",")),
-                ));
-            }
-            continue;
-        }
-        if !(6..=7).contains(&fields.len()) {
-            return Err(err(
-                line,
-                format!(
-                    "expected 6 or 7 fields (x_mm,y_mm,z_mm,i,j,k[,feed_mm_min]), got {}",
-                    fields.len()
-                ),
-            ));
-        }
-        let mut v = [0.0; 7];
-        for (q, f) in fields.iter().enumerate() {
-            v[q] = f
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| err(line, format!("field {} (`{f}`) is not a number", q + 1)))?;
-        }
-        let feed = if fields.len() == 7 {
-            if v[6] <= 0.0 {
-                return Err(err(line, format!("feed_mm_min must be > 0, got {}", v[6])));
-            }
-            Some(v[6])
-        } else {
-            path.points.last().and_then(|p| p.feed_mm_min)
-        };
-        let axis = unit_axis(file, line, [v[3], v[4], v[5]], &mut path.warnings)?;
+    for row in numeric_rows(file, text, &HEADER)? {
+        let v = &row.values;
+        let feed = row
+            .feed_mm_min
+            .or_else(|| path.points.last().and_then(|p| p.feed_mm_min));
+        let axis = unit_axis(file, row.line, [v[3], v[4], v[5]], &mut path.warnings)?;
         path.points.push(ToolpathPoint {
             p: [v[0], v[1], v[2]],
             axis,
             feed_mm_min: feed,
             rapid: false,
-            line,
+            line: row.line,
         });
     }
     if path.points.is_empty() {
@@ -483,64 +519,18 @@ pub struct JointBlock {
 /// ```
 pub fn parse_joint_csv(file: &str, text: &str) -> Result<Vec<JointBlock>, ToolpathError> {
     const HEADER: [&str; 6] = ["x_mm", "y_mm", "z_mm", "a_deg", "c_deg", "feed_mm_min"];
-    let err = |line: usize, message: String| ToolpathError::Parse {
-        file: file.into(),
-        line,
-        message,
-    };
     let mut out: Vec<JointBlock> = Vec::new();
-    for (idx, raw) in text.lines().enumerate() {
-        let line = idx + 1;
-        let body = raw.split('#').next().unwrap_or("").trim();
-        if body.is_empty() {
-            continue;
-        }
-        let fields: Vec<&str> = body.split(',').map(str::trim).collect();
-        if out.is_empty() && fields[0].parse::<f64>().is_err() {
-            let ok = (5..=6).contains(&fields.len())
-                && fields
-                    .iter()
-                    .zip(HEADER)
-                    .all(|(f, h)| f.eq_ignore_ascii_case(h));
-            if !ok {
-                return Err(err(
-                    line,
-                    format!("header `{body}`: expected {}", HEADER.join(",")),
-                ));
-            }
-            continue;
-        }
-        if !(5..=6).contains(&fields.len()) {
-            return Err(err(
-                line,
-                format!(
-                    "expected 5 or 6 fields (x_mm,y_mm,z_mm,a_deg,c_deg[,feed_mm_min]), got {}",
-                    fields.len()
-                ),
-            ));
-        }
-        let mut v = [0.0; 6];
-        for (q, f) in fields.iter().enumerate() {
-            v[q] = f
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| err(line, format!("field {} (`{f}`) is not a number", q + 1)))?;
-        }
-        let feed = if fields.len() == 6 {
-            if v[5] <= 0.0 {
-                return Err(err(line, format!("feed_mm_min must be > 0, got {}", v[5])));
-            }
-            Some(v[5])
-        } else {
-            out.last().and_then(|b| b.feed_mm_min)
-        };
+    for row in numeric_rows(file, text, &HEADER)? {
+        let v = &row.values;
+        let feed = row
+            .feed_mm_min
+            .or_else(|| out.last().and_then(|b| b.feed_mm_min));
         out.push(JointBlock {
             xyz: [v[0], v[1], v[2]],
             a_deg: v[3],
             c_deg: v[4],
             feed_mm_min: feed,
-            line,
+            line: row.line,
         });
     }
     if out.len() < 2 {
