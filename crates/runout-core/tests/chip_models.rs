@@ -580,3 +580,82 @@ fn joint_path_without_rotation_is_straight_feed() {
         }
     }
 }
+
+#[test]
+fn newton_stopping_rule_accepts_only_converged_iterates() {
+    // The exact solver stops when a step is below 1e-12 mm or when quadratic convergence
+    // guarantees the next one is (C·|dx|² < tol). Reference: 8 iterations with no early exit
+    // (tol 0: from the third-order start this is machine precision). The accepted results must
+    // agree to the 1e-12 mm tolerance on 3-axis, swing, CL-path and micro-milling cases.
+    use runout_core::chip::compare::Motion;
+    let strict = NewtonOptions {
+        tol_mm: 0.0,
+        max_iter: 8,
+    };
+    let swing = |axis: Vec3| {
+        Motion::Swing(ConstantSwing::new(Vec3::new(40.0, 0.0, 0.0), axis, deg(60.0), 0.0).unwrap())
+    };
+    let path = ClPath::new(
+        &(0..5)
+            .map(|n| ClPoint {
+                p: Vec3::new(0.4 * n as f64, 0.03 * (n * n) as f64, 0.0),
+                u: Vec3::new(deg(2.0 * n as f64).sin(), 0.0, deg(2.0 * n as f64).cos()),
+                feed: 40.0,
+            })
+            .collect::<Vec<_>>(),
+    )
+    .unwrap();
+    let cases = [
+        (
+            Cutter::flat(10.0, 4, 30.0).unwrap(),
+            0.010,
+            Motion::Straight(StraightFeed::along_x(40.0)),
+        ),
+        (
+            Cutter::flat(10.0, 4, 45.0).unwrap(),
+            0.010,
+            swing(Vec3::y()),
+        ),
+        (
+            Cutter::flat(6.0, 3, 30.0).unwrap(),
+            0.020,
+            swing(Vec3::new(1.0, 0.3, 0.0)),
+        ),
+        (
+            Cutter::flat(10.0, 4, 30.0).unwrap(),
+            0.010,
+            Motion::Path(path),
+        ),
+        (
+            Cutter::flat(0.5, 2, 30.0).unwrap(),
+            0.002,
+            Motion::Straight(StraightFeed::along_x(0.4)),
+        ),
+    ];
+    for (cutter, rho, motion) in cases {
+        let runout = Runout::new(rho, deg(40.0)).unwrap();
+        let kin = ToolKinematics::new(
+            &cutter,
+            &runout,
+            6000.0,
+            0.2,
+            SpindleSense::Clockwise,
+            motion,
+        )
+        .unwrap();
+        let mut worst: f64 = 0.0;
+        for z in [0.0, 4.0, 10.0] {
+            let geo = kin.at_height(z);
+            for q in 0..90 {
+                let t = 0.02 + 0.01 * q as f64 / 90.0;
+                for tooth in 0..cutter.teeth() {
+                    let a = exact_at(&kin, &geo, tooth, t, &NewtonOptions::default());
+                    let b = exact_at(&kin, &geo, tooth, t, &strict);
+                    assert!(a.converged);
+                    worst = worst.max((a.raw - b.raw).abs());
+                }
+            }
+        }
+        assert!(worst <= 1e-12, "R {} ρ {rho}: {worst:e}", cutter.radius());
+    }
+}
