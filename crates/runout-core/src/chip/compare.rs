@@ -113,12 +113,13 @@ impl Heights {
     }
 }
 
-/// The distinct heights of `points`, in order of first appearance.
+/// The distinct heights of `points`, in order of first appearance (a height is looked up only
+/// where it differs from the previous point's).
 fn distinct_heights(points: &[SamplePoint]) -> Vec<f64> {
     let mut v: Vec<f64> = Vec::new();
-    for q in points {
-        if !v.contains(&q.z) {
-            v.push(q.z);
+    for same in points.chunk_by(|a, b| a.z == b.z) {
+        if !v.contains(&same[0].z) {
+            v.push(same[0].z);
         }
     }
     v
@@ -165,29 +166,17 @@ pub fn equivalent_values<M: ToolMotion>(
     points: &[SamplePoint],
     params: &EquivalentParams,
 ) -> Vec<f64> {
-    // one pass: the distinct heights and each point's index among them
-    let mut zs: Vec<f64> = Vec::new();
-    let index: Vec<usize> = points
-        .iter()
-        .map(|q| {
-            zs.iter().position(|&z| z == q.z).unwrap_or_else(|| {
-                zs.push(q.z);
-                zs.len() - 1
-            })
-        })
-        .collect();
+    let zs = distinct_heights(points);
     let eval = EquivalentEvaluator::new(kin, &zs, *params);
     let mut out = Vec::with_capacity(points.len());
-    let mut start = 0;
     for run in points.chunk_by(|a, b| a.t == b.t) {
         let window = eval.look_back(run[0].t);
-        let heights = &index[start..start + run.len()];
-        out.extend(
-            run.iter()
-                .zip(heights)
-                .map(|(q, &height)| eval.raw(&window, height, q.tooth).max(0.0)),
-        );
-        start += run.len();
+        // consecutive points of one height share the height's window vectors
+        for same in run.chunk_by(|a, b| a.z == b.z) {
+            let height = zs.iter().position(|&z| z == same[0].z).expect("listed");
+            let at = eval.at_height(&window, height);
+            out.extend(same.iter().map(|q| at.raw(q.tooth).max(0.0)));
+        }
     }
     out
 }

@@ -239,64 +239,80 @@ impl<'k, M: ToolMotion> EquivalentEvaluator<'k, M> {
     /// window's time, eq. (2.8) with d_m from the look-back (module docs).
     #[inline]
     pub fn raw(&self, w: &LookBack, height: usize, tooth: usize) -> f64 {
+        self.at_height(w, height).raw(tooth)
+    }
+
+    /// The window's quantities at one height, for evaluating several teeth there.
+    #[inline]
+    pub fn at_height<'a>(&'a self, w: &'a LookBack, height: usize) -> HeightLookBack<'a, 'k, M> {
         let tab = &self.heights[height];
         let z = tab.geo.z;
-        let a1 = axpy(z, w.wu1, w.v1);
+        HeightLookBack {
+            eval: self,
+            w,
+            tab,
+            d01: axpy(z, w.du, w.dp),
+            a0: axpy(z, w.wu0, w.v0),
+            a1: axpy(z, w.wu1, w.v1),
+            half_k1: 0.5 * self.params.k1,
+        }
+    }
+}
+
+/// A [`LookBack`] window at one prepared height: A₁ − A₀, Ȧ₀, Ȧ₁ in the frame of t.
+#[derive(Debug, Clone, Copy)]
+pub struct HeightLookBack<'a, 'k, M> {
+    eval: &'a EquivalentEvaluator<'k, M>,
+    w: &'a LookBack,
+    tab: &'a HeightTable,
+    d01: Plane,
+    a0: Plane,
+    a1: Plane,
+    half_k1: f64,
+}
+
+impl<M: ToolMotion> HeightLookBack<'_, '_, M> {
+    /// Raw equivalent IUCT (mm; negative = no chip) of `tooth`, eq. (2.8).
+    ///
+    /// d_m·n and d_m·t̂ are linear in the Hermite weights, so the three window vectors are
+    /// projected on n and t̂ once per point and each pass costs six multiply-adds for them.
+    #[inline]
+    pub fn raw(&self, tooth: usize) -> f64 {
+        let (w, tab) = (self.w, self.tab);
         // ray n = (a, b)/R in (e₁, e₂), t̂ = (−b, a)/R (eq. 2.1 rotated by Θ(t))
         let [x, y] = tab.unit[tooth];
         let (sn, cs) = w.spin;
         let n = [x * cs - y * sn, x * sn + y * cs];
-        let chip = PassChip {
-            n,
-            an: (a1[0] * n[0] + a1[1] * n[1]) * self.kin.inv_omega(),
-            k1: self.params.k1,
-            k2: self.params.k2,
+        let dot_n = |v: Plane| v[0] * n[0] + v[1] * n[1];
+        let dot_t = |v: Plane| v[1] * n[0] - v[0] * n[1];
+        let an = dot_n(self.a1) * self.eval.kin.inv_omega();
+        let k2an = self.eval.params.k2 * an;
+        let half_k1 = self.half_k1;
+        let value = |delta_r: f64, inv_rp: f64, dn: f64, dt: f64| {
+            delta_r + dn + dt * inv_rp * (half_k1 * dt - k2an)
         };
         let k = tab.geo.teeth();
         let rows = &tab.passes[tooth * k..(tooth + 1) * k];
         let mut h = f64::INFINITY;
         if w.smooth {
-            let d01 = axpy(z, w.du, w.dp);
-            let a0 = axpy(z, w.wu0, w.v0);
-            for row in rows {
-                let [c0, c1, c2, ..] = *row;
-                let d = [
-                    c0 * d01[0] + c1 * a0[0] + c2 * a1[0],
-                    c0 * d01[1] + c1 * a0[1] + c2 * a1[1],
-                ];
-                h = min(h, chip.value(row, d));
+            let pn = [dot_n(self.d01), dot_n(self.a0), dot_n(self.a1)];
+            let pt = [dot_t(self.d01), dot_t(self.a0), dot_t(self.a1)];
+            for &[c0, c1, c2, delta_r, inv_rp, _] in rows {
+                let dn = c0 * pn[0] + c1 * pn[1] + c2 * pn[2];
+                let dt = c0 * pt[0] + c1 * pt[1] + c2 * pt[2];
+                h = min(h, value(delta_r, inv_rp, dn, dt));
             }
         } else {
-            let groups = &self.group[tooth * k..(tooth + 1) * k];
-            for (row, &g) in rows.iter().zip(groups) {
+            let z = tab.geo.z;
+            let groups = &self.eval.group[tooth * k..(tooth + 1) * k];
+            for (&[.., delta_r, inv_rp, shift], &g) in rows.iter().zip(groups) {
                 let [dp, du, v, wu] = w.shared[g];
                 let (d0, a0) = (axpy(z, du, dp), axpy(z, wu, v));
-                let shift = row[5];
                 let d = [d0[0] - shift * a0[0], d0[1] - shift * a0[1]];
-                h = min(h, chip.value(row, d));
+                h = min(h, value(delta_r, inv_rp, dot_n(d), dot_t(d)));
             }
         }
         h
-    }
-}
-
-/// The current ray's part of eq. (2.8): n in (e₁, e₂), a·n, k₁, k₂.
-struct PassChip {
-    n: Plane,
-    an: f64,
-    k1: f64,
-    k2: f64,
-}
-
-impl PassChip {
-    /// ΔR + d·n + k₁(d·t̂)²/(2R_{i−m}) − k₂(d·t̂)(a·n)/R_{i−m} for the pass `row` and d in (e₁, e₂).
-    #[inline(always)]
-    fn value(&self, row: &[f64; 6], d: Plane) -> f64 {
-        let [.., delta_r, inv_rp, _] = *row;
-        let n = self.n;
-        let dn = d[0] * n[0] + d[1] * n[1];
-        let dt = d[1] * n[0] - d[0] * n[1];
-        delta_r + dn + dt * inv_rp * (0.5 * self.k1 * dt - self.k2 * self.an)
     }
 }
 

@@ -29,7 +29,7 @@ pub use kinematics::{
     CircularFeed, ClPath, ClPoint, ConstantSwing, EdgeState, HeightGeometry, JointPath, JointPoint,
     Pose, SpindlePoint, SpindleSense, StraightFeed, ToolKinematics, ToolMotion, Vec3,
 };
-pub use lookback::{EquivalentEvaluator, LookBack};
+pub use lookback::{EquivalentEvaluator, HeightLookBack, LookBack};
 pub use straight::{
     straight_feed_kinematics, EquivalentAtHeight, EquivalentChip, ExactAtHeight, ExactChip,
 };
