@@ -40,6 +40,18 @@ fn axpy(a: f64, x: Plane, y: Plane) -> Plane {
 }
 
 /// The motion over one look-back window [t − T, t] (everything that depends on t only).
+///
+/// ```
+/// use runout_core::chip::*;
+/// use runout_core::{Cutter, Runout};
+/// let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+/// let runout = Runout::new(0.010, 40f64.to_radians()).unwrap();
+/// let swing = ConstantSwing::new(Vec3::new(40.0, 0.0, 0.0), Vec3::y(), 1.0, 0.0).unwrap();
+/// let kin = ToolKinematics::new(&cutter, &runout, 6000.0, 0.0, SpindleSense::Clockwise, swing).unwrap();
+/// let eval = EquivalentEvaluator::new(&kin, &[2.0, 8.0], EquivalentParams::default());
+/// let window = eval.look_back(0.05);
+/// assert!(window.is_interpolated()); // a constant swing has no junctions
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct LookBack {
     /// Current time t (s).
@@ -260,6 +272,22 @@ impl<'k, M: ToolMotion> EquivalentEvaluator<'k, M> {
 }
 
 /// A [`LookBack`] window at one prepared height: A₁ − A₀, Ȧ₀, Ȧ₁ in the frame of t.
+///
+/// ```
+/// use runout_core::chip::*;
+/// use runout_core::{Cutter, Runout};
+/// let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+/// let kin = ToolKinematics::new(&cutter, &Runout::none(), 6000.0, 0.0,
+///     SpindleSense::Clockwise, StraightFeed::along_x(40.0)).unwrap();
+/// let eval = EquivalentEvaluator::new(&kin, &[5.0], EquivalentParams::default());
+/// let window = eval.look_back(0.0321);
+/// let at = eval.at_height(&window, 0);
+/// // every tooth of the height from one set of window vectors; no runout: the teeth share the
+/// // chip, and the largest is close to f_z = 40 mm/s / (4 · 100 rev/s) = 0.1 mm
+/// let h: Vec<f64> = (0..4).map(|i| at.raw(i).max(0.0)).collect();
+/// assert!(h.iter().all(|&x| x <= 0.1 + 1e-3));
+/// assert!(h.iter().any(|&x| x > 0.05));
+/// ```
 #[derive(Debug, Clone, Copy)]
 pub struct HeightLookBack<'a, 'k, M> {
     eval: &'a EquivalentEvaluator<'k, M>,
