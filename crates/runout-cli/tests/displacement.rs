@@ -256,6 +256,38 @@ fn signal_json_and_missing_channel() {
     assert!((v["offset_um"].as_f64().unwrap() - 8.0).abs() < 0.01, "{v}");
     assert!((v["angle_deg"].as_f64().unwrap() - 30.0).abs() < 0.5, "{v}");
     assert!((v["rpm"].as_f64().unwrap() - 3000.0).abs() < 1.0);
+    assert_eq!(v["section"]["samples"], 10_000);
+    // a section (10 revolutions): same answer, and the section is reported
+    let v = json_of(&[
+        "displacement",
+        "signal",
+        p.to_str().unwrap(),
+        "--sensor-angles-deg",
+        "0,90",
+        "--from-s",
+        "0.1",
+        "--to-s",
+        "300ms",
+    ]);
+    assert!((v["offset_um"].as_f64().unwrap() - 8.0).abs() < 0.01, "{v}");
+    assert!((v["angle_deg"].as_f64().unwrap() - 30.0).abs() < 0.5, "{v}");
+    assert_eq!(v["section"]["samples"], 4001);
+    assert!((v["section"]["from_s"].as_f64().unwrap() - 0.1).abs() < 1e-9);
+    // an inverted section is refused
+    let out = runout()
+        .args([
+            "displacement",
+            "signal",
+            p.to_str().unwrap(),
+            "--from-s",
+            "0.3",
+            "--to-s",
+            "0.1",
+        ])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && e.contains("--to-s"), "{e}");
     // no reference: estimated speed, angle from the first sample (= the mark here)
     let p2 = write(d.path(), "s2.csv", &signal_csv(false));
     let v = json_of(&[

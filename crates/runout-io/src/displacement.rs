@@ -73,7 +73,8 @@ struct Table {
     rows: Vec<(u64, csv::StringRecord)>,
 }
 
-fn read_table(path: &Path) -> Result<Table, TableError> {
+/// Open a CSV table: the header (lower-cased names) and the record reader positioned after it.
+fn open_table(path: &Path) -> Result<(Table, csv::Reader<std::fs::File>), TableError> {
     let file = path.display().to_string();
     let mut rdr = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
@@ -93,30 +94,44 @@ fn read_table(path: &Path) -> Result<Table, TableError> {
         .iter()
         .map(|h| h.trim().to_ascii_lowercase())
         .collect();
-    let mut rows = Vec::new();
-    for rec in rdr.records() {
-        let rec = rec.map_err(|e| {
-            let line = e.position().map_or(0, |p| p.line());
-            TableError::Row {
-                file: file.clone(),
-                line,
-                message: e.to_string(),
-            }
-        })?;
-        let line = rec.position().map_or(0, |p| p.line());
-        rows.push((line, rec));
+    let table = Table {
+        file,
+        headers,
+        rows: Vec::new(),
+    };
+    Ok((table, rdr))
+}
+
+/// The next record and its 1-based line number, with a row error naming the line.
+fn next_record(
+    t: &Table,
+    records: &mut csv::StringRecordsIter<'_, std::fs::File>,
+) -> Result<Option<(u64, csv::StringRecord)>, TableError> {
+    match records.next() {
+        None => Ok(None),
+        Some(Err(e)) => Err(TableError::Row {
+            file: t.file.clone(),
+            line: e.position().map_or(0, |p| p.line()),
+            message: e.to_string(),
+        }),
+        Some(Ok(rec)) => Ok(Some((rec.position().map_or(0, |p| p.line()), rec))),
     }
-    if rows.is_empty() {
+}
+
+/// A whole (small) table in memory.
+fn read_table(path: &Path) -> Result<Table, TableError> {
+    let (mut t, mut rdr) = open_table(path)?;
+    let mut records = rdr.records();
+    while let Some(row) = next_record(&t, &mut records)? {
+        t.rows.push(row);
+    }
+    if t.rows.is_empty() {
         return Err(TableError::File {
-            file,
+            file: t.file,
             message: "no data rows".into(),
         });
     }
-    Ok(Table {
-        file,
-        headers,
-        rows,
-    })
+    Ok(t)
 }
 
 impl Table {
@@ -170,12 +185,17 @@ impl Table {
     /// Cell `col` of row `r` as a finite number times the column's unit factor.
     fn number(&self, r: usize, col: &Column) -> Result<f64, TableError> {
         let (line, rec) = &self.rows[r];
+        self.cell(*line, rec, col)
+    }
+
+    /// Cell `col` of record `rec` (at `line`) as a finite number times the column's unit factor.
+    fn cell(&self, line: u64, rec: &csv::StringRecord, col: &Column) -> Result<f64, TableError> {
         let text = rec.get(col.index).unwrap_or("");
         let v: f64 = text
             .parse()
-            .map_err(|_| self.cell_error(*line, col, format!("`{text}` is not a number")))?;
+            .map_err(|_| self.cell_error(line, col, format!("`{text}` is not a number")))?;
         if !v.is_finite() {
-            return Err(self.cell_error(*line, col, format!("`{text}` is not a finite number")));
+            return Err(self.cell_error(line, col, format!("`{text}` is not a finite number")));
         }
         Ok(v * col.factor)
     }
@@ -328,10 +348,52 @@ pub struct SignalTable {
     pub encoder_rad: Option<Vec<f64>>,
 }
 
+/// Which part of a raw signal to keep, and how much at most (memory stays bounded: samples
+/// outside the section are parsed and dropped, never stored).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SignalSection {
+    /// Keep samples at t ≥ `from_s` (s); `None` = from the start.
+    pub from_s: Option<f64>,
+    /// Keep samples at t ≤ `to_s` (s); `None` = to the end.
+    pub to_s: Option<f64>,
+    /// Largest number of samples kept; more is an error that asks for a shorter section.
+    pub max_samples: usize,
+}
+
+impl SignalSection {
+    /// Default cap: 20 M samples (400 s at 50 kHz; ≈ 32 B per sample with two channels).
+    pub const MAX_SAMPLES: usize = 20_000_000;
+}
+
+impl Default for SignalSection {
+    fn default() -> Self {
+        SignalSection {
+            from_s: None,
+            to_s: None,
+            max_samples: Self::MAX_SAMPLES,
+        }
+    }
+}
+
 /// Read a raw signal: `time_<s|ms>`, `disp_<name>_<unit>` columns, optional `pulse` or
-/// `encoder_<deg|rad>`. The time step must be constant (every sample within ¼ step of the grid).
-pub fn read_signal(path: &Path) -> Result<SignalTable, TableError> {
-    let t = read_table(path)?;
+/// `encoder_<deg|rad>`, keeping the samples of `section` (parsed straight into numbers, one
+/// record at a time). The time step must be constant (every kept sample within ¼ step of the
+/// grid).
+///
+/// ```
+/// use runout_io::displacement::{read_signal, SignalSection};
+/// let dir = tempfile::tempdir().unwrap();
+/// let p = dir.path().join("s.csv");
+/// let rows: String = (0..100).map(|i| format!("{},{}\n", i as f64 * 1e-3, i)).collect();
+/// std::fs::write(&p, format!("time_s,disp_a_um\n{rows}")).unwrap();
+/// let section = SignalSection { from_s: Some(0.0105), to_s: Some(0.0195), ..Default::default() };
+/// let t = read_signal(&p, &section).unwrap();
+/// assert_eq!(t.channels[0].1.len(), 9); // 11 ms … 19 ms
+/// assert!((t.start_s - 0.011).abs() < 1e-12);
+/// assert!((t.sample_rate_hz - 1000.0).abs() < 1e-6);
+/// ```
+pub fn read_signal(path: &Path, section: &SignalSection) -> Result<SignalTable, TableError> {
+    let (t, mut rdr) = open_table(path)?;
     let time = t
         .unit_column("time", Quantity::TimeS)?
         .ok_or_else(|| t.missing("`time_<unit>` (e.g. time_s)"))?;
@@ -357,51 +419,92 @@ pub fn read_signal(path: &Path) -> Result<SignalTable, TableError> {
             t.missing("`disp_<name>_<unit>` (e.g. disp_a_um): at least one displacement channel")
         );
     }
-    let n = t.rows.len();
-    let times: Vec<f64> = (0..n)
-        .map(|r| t.number(r, &time))
-        .collect::<Result<_, _>>()?;
-    let sample_rate_hz = check_time_grid(&t, &time, &times)?;
+    let pulse_col = t.plain_column("pulse");
+    let encoder_col = t.unit_column("encoder", Quantity::AngleDeg)?;
+    let from = section.from_s.unwrap_or(f64::NEG_INFINITY);
+    let to = section.to_s.unwrap_or(f64::INFINITY);
+    let mut times = Vec::new();
+    let mut lines = Vec::new();
+    let mut values: Vec<Vec<f64>> = vec![Vec::new(); disp.len()];
+    let mut pulse = pulse_col.as_ref().map(|_| Vec::new());
+    let mut encoder = encoder_col.as_ref().map(|_| Vec::new());
+    let mut rows = 0usize;
+    let mut records = rdr.records();
+    while let Some((line, rec)) = next_record(&t, &mut records)? {
+        rows += 1;
+        let ti = t.cell(line, &rec, &time)?;
+        if ti < from {
+            continue;
+        }
+        if ti > to {
+            break;
+        }
+        if times.len() == section.max_samples {
+            return Err(TableError::Row {
+                file: t.file.clone(),
+                line,
+                message: format!(
+                    "more than {} samples in the selected section: select a shorter one (--from-s/--to-s, s); a few revolutions suffice",
+                    section.max_samples
+                ),
+            });
+        }
+        times.push(ti);
+        lines.push(line);
+        for (c, v) in disp.iter().zip(values.iter_mut()) {
+            v.push(t.cell(line, &rec, c)?);
+        }
+        if let (Some(c), Some(p)) = (&pulse_col, pulse.as_mut()) {
+            p.push(t.cell(line, &rec, c)?);
+        }
+        if let (Some(c), Some(e)) = (&encoder_col, encoder.as_mut()) {
+            e.push(t.cell(line, &rec, c)?.to_radians());
+        }
+    }
+    if rows == 0 {
+        return Err(TableError::File {
+            file: t.file.clone(),
+            message: "no data rows".into(),
+        });
+    }
+    if times.is_empty() {
+        return Err(TableError::File {
+            file: t.file.clone(),
+            message: format!(
+                "no sample in the selected section [{}, {}] s",
+                section.from_s.map_or("start".into(), |v| v.to_string()),
+                section.to_s.map_or("end".into(), |v| v.to_string())
+            ),
+        });
+    }
+    let sample_rate_hz = check_time_grid(&t, &time, &times, &lines)?;
     let channels = disp
         .iter()
-        .map(|c| {
-            let v = (0..n)
-                .map(|r| t.number(r, c))
-                .collect::<Result<Vec<f64>, _>>()?;
+        .zip(values)
+        .map(|(c, v)| {
             let name = c
                 .name
                 .trim_start_matches("disp_")
                 .rsplit_once('_')
                 .map_or(c.name.clone(), |x| x.0.to_string());
-            Ok((name, v))
+            (name, v)
         })
-        .collect::<Result<_, TableError>>()?;
-    let pulse = t
-        .plain_column("pulse")
-        .map(|c| {
-            (0..n)
-                .map(|r| t.number(r, &c))
-                .collect::<Result<Vec<f64>, _>>()
-        })
-        .transpose()?;
-    let encoder_rad = t
-        .unit_column("encoder", Quantity::AngleDeg)?
-        .map(|c| {
-            (0..n)
-                .map(|r| t.number(r, &c).map(f64::to_radians))
-                .collect::<Result<Vec<f64>, _>>()
-        })
-        .transpose()?;
+        .collect();
     Ok(SignalTable {
         sample_rate_hz,
         start_s: times[0],
         channels,
         pulse,
-        encoder_rad,
+        encoder_rad: encoder,
     })
 }
 
-fn check_time_grid(t: &Table, col: &Column, times: &[f64]) -> Result<f64, TableError> {
+fn check_time_grid(
+    t: &Table,
+    col: &Column,
+    times: &[f64],
+    lines: &[u64],
+) -> Result<f64, TableError> {
     let n = times.len();
     if n < 2 {
         return Err(TableError::File {
@@ -411,12 +514,39 @@ fn check_time_grid(t: &Table, col: &Column, times: &[f64]) -> Result<f64, TableE
     }
     let dt = (times[n - 1] - times[0]) / (n - 1) as f64;
     if dt.is_nan() || dt <= 0.0 {
-        return Err(t.cell_error(t.rows[n - 1].0, col, "time does not increase".into()));
+        return Err(t.cell_error(lines[n - 1], col, "time does not increase".into()));
+    }
+    // a gap, a jump back or a repeated time first shows as one step far from the mean step:
+    // name that line rather than where the accumulated drift leaves the grid
+    for i in 1..n {
+        let step = times[i] - times[i - 1];
+        if step <= 0.0 {
+            return Err(t.cell_error(
+                lines[i],
+                col,
+                format!(
+                    "time does not increase ({} s after {} s on line {})",
+                    times[i],
+                    times[i - 1],
+                    lines[i - 1]
+                ),
+            ));
+        }
+        if (step - dt).abs() > 0.5 * dt {
+            return Err(t.cell_error(
+                lines[i],
+                col,
+                format!(
+                    "time step {step:.6e} s from the previous sample (line {}) differs from the mean step {dt:.6e} s: samples must be evenly spaced without gaps (not on a constant-rate grid)",
+                    lines[i - 1]
+                ),
+            ));
+        }
     }
     for (i, &ti) in times.iter().enumerate() {
         if (ti - times[0] - i as f64 * dt).abs() > 0.25 * dt {
             return Err(t.cell_error(
-                t.rows[i].0,
+                lines[i],
                 col,
                 format!(
                     "time {ti} s is off the constant-rate grid (step {dt:.6e} s): samples must be evenly spaced without gaps"

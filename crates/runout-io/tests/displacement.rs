@@ -108,7 +108,7 @@ fn signal_table() {
         );
     }
     let p = file(&d, "s.csv", &s);
-    let t = read_signal(&p).unwrap();
+    let t = read_signal(&p, &SignalSection::default()).unwrap();
     assert!((t.sample_rate_hz - 50_000.0).abs() < 1e-6);
     assert_eq!(t.channels[0].0, "a");
     assert_eq!(t.channels[1].0, "b");
@@ -122,13 +122,70 @@ fn signal_table() {
         "gap.csv",
         "time_s,disp_a_um\n0,1\n0.1,1\n0.2,1\n0.5,1\n0.6,1\n",
     );
-    let e = read_signal(&p).unwrap_err().to_string();
+    let e = read_signal(&p, &SignalSection::default())
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("gap.csv:") && e.contains("time_s") && e.contains("grid"),
         "{e}"
     );
     // no displacement channel
     let p = file(&d, "none.csv", "time_s,pulse\n0,1\n0.1,0\n");
-    let e = read_signal(&p).unwrap_err().to_string();
+    let e = read_signal(&p, &SignalSection::default())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("disp_<name>_<unit>"), "{e}");
+}
+
+#[test]
+fn signal_section_and_sample_cap() {
+    // 1 000 samples at 1 kHz (time in ms); the gap after 0.8 s lies outside the section
+    let d = tempfile::tempdir().unwrap();
+    let mut s = String::from("time_ms,disp_a_um\n");
+    for i in 0..1000 {
+        let t_ms = if i < 800 { i as f64 } else { i as f64 + 50.0 };
+        s += &format!("{t_ms},{}\n", i % 7);
+    }
+    let p = file(&d, "long.csv", &s);
+    let sec = SignalSection {
+        from_s: Some(0.1),
+        to_s: Some(0.3995),
+        ..Default::default()
+    };
+    let t = read_signal(&p, &sec).unwrap();
+    assert_eq!(t.channels[0].1.len(), 300); // 100 ms … 399 ms
+    assert!((t.start_s - 0.1).abs() < 1e-12);
+    assert!((t.channels[0].1[0] - 100.0 % 7.0 * 1e-3).abs() < 1e-15);
+    // the whole file has the gap: refused with its line (header = line 1, sample i = line i + 2)
+    let e = read_signal(&p, &SignalSection::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("long.csv:802") && e.contains("grid"), "{e}");
+    // the cap names the line where it is exceeded and how to select less
+    let cap = SignalSection {
+        max_samples: 250,
+        ..Default::default()
+    };
+    let e = read_signal(&p, &cap).unwrap_err().to_string();
+    assert!(e.contains("long.csv:252") && e.contains("--from-s"), "{e}");
+    // time going back names its line
+    let p2 = file(
+        &d,
+        "back.csv",
+        "time_s,disp_a_um\n0,1\n0.1,1\n0.2,1\n0.15,1\n0.3,1\n",
+    );
+    let e = read_signal(&p2, &SignalSection::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("back.csv:5") && e.contains("does not increase"),
+        "{e}"
+    );
+    // an empty section
+    let none = SignalSection {
+        from_s: Some(5.0),
+        ..Default::default()
+    };
+    let e = read_signal(&p, &none).unwrap_err().to_string();
+    assert!(e.contains("no sample in the selected section"), "{e}");
 }

@@ -6,7 +6,7 @@ use runout_core::displacement::{
     fit_signal, identify_from_teeth, per_revolution_runout, per_tooth_extrema, SensorChannel,
     SignalFit, SignalInput, SpindleReference, ToothFitOptions,
 };
-use runout_io::displacement::read_signal;
+use runout_io::displacement::{read_signal, SignalSection};
 use runout_io::displacement_plot::{teeth_polar_plot, TeethPlot};
 
 /// Arguments of `runout displacement signal`.
@@ -34,6 +34,13 @@ pub struct Args {
     /// Spindle angle of tooth 0 measured from the once-per-revolution mark (deg); λ is reported from tooth 0.
     #[arg(long, allow_hyphen_values = true)]
     pub tooth0_deg: Option<String>,
+    /// Start of the section to analyse (s, on the file's time axis); default: the start. Samples
+    /// outside the section are read and dropped, so long files need not fit in memory.
+    #[arg(long, allow_hyphen_values = true)]
+    pub from_s: Option<String>,
+    /// End of the section to analyse (s); default: the end. At most 20 M samples are kept.
+    #[arg(long, allow_hyphen_values = true)]
+    pub to_s: Option<String>,
     #[command(flatten)]
     pub cutter: CutterFlags,
     #[command(flatten)]
@@ -44,7 +51,17 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<()> {
     let file = a.recording.display().to_string();
-    let table = read_signal(&a.recording)?;
+    let section = SignalSection {
+        from_s: quantity("from-s", &a.from_s, Quantity::TimeS)?,
+        to_s: quantity("to-s", &a.to_s, Quantity::TimeS)?,
+        ..Default::default()
+    };
+    if let (Some(f), Some(t)) = (section.from_s, section.to_s) {
+        if t <= f {
+            bail!("--to-s ({t} s) must be after --from-s ({f} s)");
+        }
+    }
+    let table = read_signal(&a.recording, &section)?;
     let sign = sensor_sign(&a.beam.sensor)?;
     let angles = sensor_angles(&a.sensor_angles_deg, table.channels.len())?;
     let beam = a.beam.beam()?;
@@ -94,6 +111,9 @@ pub fn run(a: Args) -> Result<()> {
     // seed eq. (5) is a by-product: a record without a complete revolution still gets the fit
     let revs = per_revolution_runout(&input, &track).unwrap_or_default();
     let mut json = to_json(&file, &table.channels, &fit)?;
+    let samples = table.channels[0].1.len();
+    let end_s = table.start_s + (samples - 1) as f64 / table.sample_rate_hz;
+    json["section"] = json!({"from_s": table.start_s, "to_s": end_s, "samples": samples});
     json["beam"] = a.beam.json()?;
     json["per_revolution"] = revs
         .iter()
@@ -103,6 +123,10 @@ pub fn run(a: Args) -> Result<()> {
         })
         .collect();
     let mut text = to_text(&file, &table.channels, &fit);
+    text += &format!(
+        "  section {:.6}–{end_s:.6} s ({samples} samples at {:.1} Hz)\n",
+        table.start_s, table.sample_rate_hz
+    );
     for (r, (name, _)) in revs.iter().zip(&table.channels) {
         text += &format!(
             "  channel {name}: TIR/2 per revolution (seed eq. 5) {:.4} µm (sd {})\n",
