@@ -30,6 +30,29 @@ struct Setup {
     lambda_deg: f64,
 }
 
+/// The set-up's cut with `cutter` at feed `fz` (mm), its runout and coefficients `kc`, and the
+/// arc chip model.
+fn force_model(
+    s: &Setup,
+    cutter: Cutter,
+    fz: f64,
+    kc: CuttingCoefficients,
+) -> (ForceModel, ArcChip) {
+    let runout = Runout::new(s.rho_um * 1e-3, s.lambda_deg.to_radians()).unwrap();
+    let cut = Cut::new(3000.0, fz, s.ap_mm)
+        .unwrap()
+        .radial(s.ae_mm, s.mode, &cutter)
+        .unwrap();
+    let chip = ArcChip::new(&cutter, &runout, fz).unwrap();
+    let model = ForceModel {
+        cutter,
+        runout,
+        cut,
+        coefficients: kc,
+    };
+    (model, chip)
+}
+
 /// Simulate 20 revolutions at 1° steps, add white noise of σ = 2 % of each component's peak |F|
 /// to that component, and average synchronously (with the per-sample standard errors).
 fn recording(
@@ -39,18 +62,8 @@ fn recording(
     seed: u64,
 ) -> (WaveformCase, ForceSeries) {
     let cutter = Cutter::flat(10.0, s.teeth, s.helix_deg).unwrap();
-    let runout = Runout::new(s.rho_um * 1e-3, s.lambda_deg.to_radians()).unwrap();
-    let cut = Cut::new(3000.0, fz, s.ap_mm)
-        .unwrap()
-        .radial(s.ae_mm, s.mode, &cutter)
-        .unwrap();
-    let model = ForceModel {
-        cutter: cutter.clone(),
-        runout,
-        cut,
-        coefficients: kc,
-    };
-    let chip = ArcChip::new(&cutter, &runout, fz).unwrap();
+    let (model, chip) = force_model(s, cutter.clone(), fz, kc);
+    let cut = model.cut;
     // the "truth" uses finer disks (helix lag 0.05° per disk) than the identification model's
     // automatic choice (0.1°)
     let lag_deg = (s.ap_mm * s.helix_deg.to_radians().tan() / 5.0).to_degrees();
@@ -389,18 +402,7 @@ fn two_teeth_straight_forces(s: &Setup, fz: f64, delta: f64) -> ForceSeries {
     use std::f64::consts::PI;
     let pitch = vec![PI - 2.0 * delta, PI + 2.0 * delta];
     let cutter = Cutter::new(10.0, pitch, 0.0, f64::INFINITY, RadiusProfile::Flat).unwrap();
-    let runout = Runout::new(s.rho_um * 1e-3, s.lambda_deg.to_radians()).unwrap();
-    let cut = Cut::new(3000.0, fz, s.ap_mm)
-        .unwrap()
-        .radial(s.ae_mm, s.mode, &cutter)
-        .unwrap();
-    let chip = ArcChip::new(&cutter, &runout, fz).unwrap();
-    let model = ForceModel {
-        cutter,
-        runout,
-        cut,
-        coefficients: kc(),
-    };
+    let (model, chip) = force_model(s, cutter, fz, kc());
     model.simulate(&chip, &Sampling::new(1.0, 1.0, 1).unwrap())
 }
 

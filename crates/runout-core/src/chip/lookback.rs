@@ -196,16 +196,6 @@ impl<'k, M: ToolMotion> EquivalentEvaluator<'k, M> {
         }
     }
 
-    /// The prepared geometry of height index `height`.
-    pub fn geometry(&self, height: usize) -> &HeightGeometry {
-        &self.heights[height].geo
-    }
-
-    /// Number of prepared heights.
-    pub fn heights(&self) -> usize {
-        self.heights.len()
-    }
-
     /// The look-back window ending at time `t`: two poses and one spindle angle, plus one pose
     /// per nominal look-back when the window spans a junction of the motion.
     pub fn look_back(&self, t: f64) -> LookBack {
@@ -266,7 +256,6 @@ impl<'k, M: ToolMotion> EquivalentEvaluator<'k, M> {
             d01: axpy(z, w.du, w.dp),
             a0: axpy(z, w.wu0, w.v0),
             a1: axpy(z, w.wu1, w.v1),
-            half_k1: 0.5 * self.params.k1,
         }
     }
 }
@@ -296,7 +285,6 @@ pub struct HeightLookBack<'a, 'k, M> {
     d01: Plane,
     a0: Plane,
     a1: Plane,
-    half_k1: f64,
 }
 
 impl<M: ToolMotion> HeightLookBack<'_, '_, M> {
@@ -315,7 +303,7 @@ impl<M: ToolMotion> HeightLookBack<'_, '_, M> {
         let dot_t = |v: Plane| v[1] * n[0] - v[0] * n[1];
         let an = dot_n(self.a1) * self.eval.kin.inv_omega();
         let k2an = self.eval.params.k2 * an;
-        let half_k1 = self.half_k1;
+        let half_k1 = 0.5 * self.eval.params.k1;
         let value = |delta_r: f64, inv_rp: f64, dn: f64, dt: f64| {
             delta_r + dn + dt * inv_rp * (half_k1 * dt - k2an)
         };
