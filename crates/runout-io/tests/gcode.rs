@@ -162,11 +162,8 @@ fn unsupported_and_malformed_blocks_name_line_and_column() {
 /// rewritten program and reports, per line, the X/Y/Z words it understood; they must equal the
 /// values our rewriter intended (original target + offset) to the written 4 decimals.
 #[test]
+#[ignore = "needs python3 with pygcode: .ci/run installs it and runs the ignored cross-checks"]
 fn pygcode_reads_the_rewritten_program() {
-    if Command::new("python3").arg("--version").output().is_err() {
-        eprintln!("NOTICE: python3 not found; skipping the pygcode cross-check");
-        return;
-    }
     let p = NcProgram::parse(PROGRAM).unwrap();
     let n = p.motion_blocks().len();
     let out = p.rewrite(&offsets(n), &RewriteOptions::default()).unwrap();
