@@ -19,6 +19,7 @@
 #![warn(missing_docs)]
 
 pub mod angle;
+pub mod chain;
 pub mod chip;
 pub mod coefficients;
 pub mod cut;
