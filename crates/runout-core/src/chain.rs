@@ -64,7 +64,11 @@ impl SensorMode {
             ));
         }
         if !gain.is_finite() {
-            return Err(ParamError::new("sensor_gain", "a finite relative gain", gain));
+            return Err(ParamError::new(
+                "sensor_gain",
+                "a finite relative gain",
+                gain,
+            ));
         }
         Ok(SensorMode {
             frequency_hz,
@@ -145,7 +149,7 @@ impl FrfCurve {
     /// first (static) value 1 is used.
     pub fn at(&self, f_hz: f64) -> Option<Complex64> {
         let f = &self.freq_hz;
-        if !(f_hz <= self.max_frequency_hz()) {
+        if f_hz.is_nan() || f_hz > self.max_frequency_hz() {
             return None;
         }
         if f_hz <= f[0] {
@@ -184,6 +188,14 @@ impl AxisChain {
                 )
             }
             AxisChain::Frf(c) => c.at(f_hz),
+        }
+    }
+
+    /// H(f), a measured FRF held at its last value above its range.
+    pub fn response_clamped(&self, f_hz: f64) -> Complex64 {
+        match self {
+            AxisChain::Frf(c) => c.at(f_hz).unwrap_or(c.values[c.values.len() - 1]),
+            other => other.response(f_hz).unwrap_or(Complex64::new(1.0, 0.0)),
         }
     }
 
@@ -315,10 +327,10 @@ mod tests {
             let y = AxisChain::Modes(vec![m]).filter(fs, &u);
             // fit a·sin + b·cos over the last half (transient decayed: e^{−ζωt} < 1e-20)
             let (mut ss, mut sc) = (0.0, 0.0);
-            for q in n / 2..n {
+            for (q, yq) in y.iter().enumerate().skip(n / 2) {
                 let ph = std::f64::consts::TAU * f * q as f64 / fs;
-                ss += y[q] * ph.sin();
-                sc += y[q] * ph.cos();
+                ss += yq * ph.sin();
+                sc += yq * ph.cos();
             }
             let half = (n / 2) as f64 / 2.0;
             let got = Complex64::new(ss / half, sc / half);
@@ -338,8 +350,12 @@ mod tests {
         let f = 950.0;
         let (dfn, dz) = m.unit_response_derivatives(f);
         let h = 1e-4;
-        let num_fn = (SensorMode::new(1100.0 + h, 0.05, 1.0).unwrap().unit_response(f)
-            - SensorMode::new(1100.0 - h, 0.05, 1.0).unwrap().unit_response(f))
+        let num_fn = (SensorMode::new(1100.0 + h, 0.05, 1.0)
+            .unwrap()
+            .unit_response(f)
+            - SensorMode::new(1100.0 - h, 0.05, 1.0)
+                .unwrap()
+                .unit_response(f))
             / (2.0 * h);
         let num_z = (SensorMode::new(1100.0, 0.05 + 1e-7, 1.0)
             .unwrap()
@@ -367,7 +383,11 @@ mod tests {
         assert_eq!(c.at(0.0), Some(Complex64::new(1.0, 0.0)));
         assert_eq!(c.at(50.0), Some(Complex64::new(1.5, 0.5)));
         assert_eq!(c.at(200.1), None);
-        let err = FrfCurve::new("f.csv xx", vec![0.0, 0.0], vec![Complex64::new(1.0, 0.0); 2]);
+        let err = FrfCurve::new(
+            "f.csv xx",
+            vec![0.0, 0.0],
+            vec![Complex64::new(1.0, 0.0); 2],
+        );
         assert!(err.unwrap_err().to_string().contains("f.csv xx row 2"));
     }
 

@@ -28,8 +28,10 @@
 //! columns; above 1e8 the fit is flagged ill-conditioned. Averaged-waveform samples are treated
 //! as independent (true for white measurement noise; coloured noise makes the SEs optimistic).
 
+use super::covariance::{fit_covariance, time_blocks_to_harmonics, FitCovariance};
 use super::error::IdentifyError;
 use super::frequency::{frequency_estimate, FrequencyEstimate};
+use super::harmonic_fit::{harmonic_fit, ChainFitReport, ChainOptions};
 use super::lsq::linear_lsq;
 use super::model::{
     coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel,
@@ -52,6 +54,9 @@ pub struct FullSignalOptions {
     pub fit_tilt: bool,
     /// Start value of the runout vector e (mm); `None` = frequency-domain estimate.
     pub initial_runout: Option<[f64; 2]>,
+    /// Fit through a measuring chain (fitted modes, a known FRF or a band limit) in the
+    /// harmonic domain ([`super::harmonic_fit`]); `None` = rigid sensor, time-domain fit.
+    pub chain: Option<ChainOptions>,
 }
 
 /// Result of the full-signal fit. Offsets mm, angles rad, coefficients N/mm² and N/mm.
@@ -97,6 +102,8 @@ pub struct FullSignalFit {
     pub disks: usize,
     /// Warnings (ill-conditioning, non-convergence, coefficients not identified).
     pub warnings: Vec<String>,
+    /// The measuring chain of a chain-aware fit (`None` for the rigid time-domain fit).
+    pub chain: Option<ChainFitReport>,
 }
 
 /// Which part of the runout vector the data determine.
@@ -392,25 +399,53 @@ fn pattern_search(p: &mut Problem<'_>) -> usize {
     let x0 = p.x.clone();
     p.set_params(&x0);
     let dirs = search_directions(p);
-    let mut best = profile_cost(p);
-    let mut x = p.x.clone();
     let (e, _) = p.runout();
-    let mut step = (0.05 * e[0].hypot(e[1]) * 1e3).max(0.5);
+    let step = (0.05 * e[0].hypot(e[1]) * 1e3).max(0.5);
+    let start: Vec<f64> = (0..nr).map(|k| x0[k]).collect();
+    let (best, evals) = compass_search(&start, &dirs, step, |t| {
+        let mut x = p.x.clone();
+        for (k, v) in t.iter().enumerate() {
+            x[k] = *v;
+        }
+        p.set_params(&x);
+        profile_cost(p)
+    });
+    let mut x = p.x.clone();
+    for (k, v) in best.iter().enumerate() {
+        x[k] = *v;
+    }
+    p.set_params(&x);
+    profile_cost(p);
+    evals
+}
+
+/// Compass (pattern) search: from `x0` try ± `step`·d along each direction d, take the first
+/// improvement, halve the step when none improves; stop below 0.005 (µm) or after 600
+/// evaluations. Returns the best point and the number of cost evaluations.
+pub(crate) fn compass_search(
+    x0: &[f64],
+    dirs: &[Vec<f64>],
+    step0: f64,
+    mut cost: impl FnMut(&[f64]) -> f64,
+) -> (Vec<f64>, usize) {
+    let mut x = x0.to_vec();
+    let mut best = cost(&x);
+    let mut step = step0;
     let mut evals = 1;
     while step > 0.005 && evals < 600 {
         let mut moved = false;
-        for d in &dirs {
+        for d in dirs {
             for sign in [1.0, -1.0] {
-                let mut trial = x.clone();
-                for k in 0..nr {
-                    trial[k] += sign * step * d[k];
-                }
-                p.set_params(&trial);
-                let c = profile_cost(p);
+                let trial: Vec<f64> = x
+                    .iter()
+                    .zip(d)
+                    .map(|(v, dv)| v + sign * step * dv)
+                    .collect();
+                let c = cost(&trial);
                 evals += 1;
                 if c < best {
                     best = c;
-                    x = p.x.clone();
+                    x = trial;
                     moved = true;
                     break;
                 }
@@ -420,8 +455,24 @@ fn pattern_search(p: &mut Problem<'_>) -> usize {
             step *= 0.5;
         }
     }
-    p.set_params(&x);
-    evals
+    (x, evals)
+}
+
+/// Scan points of the runout vector around the start values: 16 angles × offsets 0.5, 1, 1.5 of
+/// the largest start offset (at least 2 µm).
+pub(crate) fn candidate_runouts(starts: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    let r0 = starts
+        .iter()
+        .map(|e| e[0].hypot(e[1]))
+        .fold(0.002, f64::max);
+    let mut out = Vec::with_capacity(48);
+    for scale in [0.5, 1.0, 1.5] {
+        for a in 0..16 {
+            let (s, c) = (a as f64 * std::f64::consts::TAU / 16.0).sin_cos();
+            out.push([r0 * scale * c, r0 * scale * s]);
+        }
+    }
+    out
 }
 
 /// Search directions for [`pattern_search`]: eigenvectors of the profile Gauss–Newton matrix of
@@ -507,9 +558,9 @@ fn linear_coefficients(p: &mut Problem<'_>) -> Result<(), IdentifyError> {
 /// moving the runout moves that boundary, and with many axial disks the sum of the small steps is
 /// a real slope. Ignoring it stalled LM 1.9 µm from the optimum (K = 2, ρ = 27 µm); a 0.1 µm
 /// difference spans enough steps to see the macroscopic slope.
-const RUNOUT_STEP_UM: f64 = 0.1;
+pub(crate) const RUNOUT_STEP_UM: f64 = 0.1;
 
-const NAMES: [&str; 6] = ["ktc", "krc", "kac", "kte", "kre", "kae"];
+pub(crate) const NAMES: [&str; 6] = ["ktc", "krc", "kac", "kte", "kre", "kae"];
 
 /// Identify runout (and tilt) and the cutting coefficients from averaged waveforms.
 pub fn full_signal_fit(
@@ -529,6 +580,9 @@ pub fn full_signal_fit(
         .disks
         .unwrap_or_else(|| auto_disks(cases, options.fit_tilt))
         .max(1);
+    if let Some(chain) = &options.chain {
+        return harmonic_fit(cases, options, chain, disks);
+    }
     let coef_idx = fitted_coefficients(cases);
     let nr_full = if options.fit_tilt { 4 } else { 2 };
     let np_full = nr_full + coef_idx.len();
@@ -587,16 +641,7 @@ pub fn full_signal_fit(
     if let Some(f) = initial {
         candidates.push(f.vector);
     }
-    let r0 = candidates
-        .iter()
-        .map(|e| e[0].hypot(e[1]))
-        .fold(0.002, f64::max);
-    for scale in [0.5, 1.0, 1.5] {
-        for a in 0..16 {
-            let (s, c) = (a as f64 * std::f64::consts::TAU / 16.0).sin_cos();
-            candidates.push([r0 * scale * c, r0 * scale * s]);
-        }
-    }
+    candidates.extend(candidate_runouts(&candidates));
     // Stage 1 on the smooth variant of the model (edge forces over the whole engagement window,
     // continuous in e): scan, then LM. Stage 2: derivative-free pattern search on the exact model
     // (edge forces only where h > 0, as the simulation) from the stage-1 solution. With straight
@@ -650,67 +695,30 @@ pub fn full_signal_fit(
         .residuals()
         .ok_or_else(|| IdentifyError::singular("full-signal fit", "non-finite residuals"))?;
     let raw = problem.raw_residuals();
-    let rss_w = res.norm_squared();
-    let dof = n - np;
-    let s2 = rss_w / dof as f64;
-
-    // Condition number of the column-normalised Jacobian, and the covariance.
-    let norms: Vec<f64> = (0..np)
-        .map(|c| jac.column(c).norm().max(f64::MIN_POSITIVE))
+    // Robust covariance: rotate each (recording, component) block to harmonics.
+    let blocks: Vec<usize> = cases
+        .iter()
+        .flat_map(|c| std::iter::repeat_n(c.waveform.samples(), c.waveform.components.len()))
         .collect();
-    let jn = DMatrix::from_fn(n, np, |r, c| jac[(r, c)] / norms[c]);
-    let svd = jn.svd(false, true);
-    let (smax, smin) = (svd.singular_values.max(), svd.singular_values.min());
-    let condition = if smin > 0.0 {
-        smax / smin
-    } else {
-        f64::INFINITY
-    };
-    let v_t = svd.v_t.as_ref().expect("V computed");
-    let inv = DMatrix::from_diagonal(&svd.singular_values.map(|s| {
-        if s > 0.0 {
-            1.0 / (s * s)
-        } else {
-            f64::INFINITY
-        }
-    }));
-    let cov_n = v_t.transpose() * inv * v_t;
-    let cov = DMatrix::from_fn(np, np, |r, c| cov_n[(r, c)] * s2 / (norms[r] * norms[c]));
-    let se = |i: usize| cov[(i, i)].max(0.0).sqrt();
-    let correlation: Vec<Vec<f64>> = (0..np)
-        .map(|r| (0..np).map(|c| cov[(r, c)] / (se(r) * se(c))).collect())
-        .collect();
-
-    // Runout in mm with delta-method ρ, λ: e = D·t, Cov(e) = D·Cov(t)·Dᵀ.
-    let ([ex, ey], _) = problem.runout();
-    let nd = problem.dirs.len();
-    let mut cov_e = [[0.0; 2]; 2];
-    for (a, row) in cov_e.iter_mut().enumerate() {
-        for (b, v) in row.iter_mut().enumerate() {
-            for p in 0..nd {
-                for q in 0..nd {
-                    *v += problem.dirs[p][a] * cov[(p, q)] * problem.dirs[q][b] * 1e-6;
-                }
-            }
+    let (jh, rh, groups) = time_blocks_to_harmonics(&jac, &res, &blocks);
+    let cov = fit_covariance(&jh, &rh, &groups);
+    // R² about each component's mean, unweighted.
+    let mut tss = 0.0;
+    for case in cases {
+        for comp in &case.waveform.components {
+            let m = comp.values.iter().sum::<f64>() / comp.values.len() as f64;
+            tss += comp.values.iter().map(|v| (v - m).powi(2)).sum::<f64>();
         }
     }
-    let rho = ex.hypot(ey);
-    let quad = |g: [f64; 2]| {
-        (g[0] * g[0] * cov_e[0][0] + 2.0 * g[0] * g[1] * cov_e[0][1] + g[1] * g[1] * cov_e[1][1])
-            .max(0.0)
-            .sqrt()
-    };
-    let (g_rho, g_lam) = if rho > 0.0 {
-        ([ex / rho, ey / rho], [-ey / (rho * rho), ex / (rho * rho)])
-    } else {
-        ([f64::NAN; 2], [f64::NAN; 2])
-    };
+    let rss: f64 = raw.iter().map(|r| r * r).sum();
+    let (e, tau) = problem.runout();
     let mut coefficients = [0.0; 6];
     let mut coefficient_se = [None; 6];
     for (p, &i) in coef_idx.iter().enumerate() {
         coefficients[i] = problem.x[nr + p];
-        coefficient_se[i] = Some(se(nr + p));
+        coefficient_se[i] = Some(cov.se(nr + p));
     }
+    let nd = problem.dirs.len();
     let mut parameters: Vec<String> = if nd == 2 {
         vec!["ex_um".to_string(), "ey_um".to_string()]
     } else {
@@ -723,27 +731,84 @@ pub fn full_signal_fit(
         ]);
     }
     parameters.extend(coef_idx.iter().map(|&i| NAMES[i].to_string()));
+    Ok(fit_summary(FitSummaryInput {
+        e,
+        tau: options.fit_tilt.then_some(tau),
+        cov: &cov,
+        runout_dirs: &problem.dirs,
+        coefficients,
+        coefficient_se,
+        parameters,
+        rss,
+        tss,
+        n,
+        np,
+        evaluations: report.number_of_evaluations,
+        termination: format!("{:?}", report.termination),
+        converged: report.termination.was_successful(),
+        initial,
+        disks,
+        observability,
+        has_z: coef_idx.len() == 6,
+    }))
+}
 
-    // R² about each component's mean, unweighted.
-    let mut tss = 0.0;
-    for case in cases {
-        for comp in &case.waveform.components {
-            let m = comp.values.iter().sum::<f64>() / comp.values.len() as f64;
-            tss += comp.values.iter().map(|v| (v - m).powi(2)).sum::<f64>();
+/// What [`fit_summary`] turns into a [`FullSignalFit`].
+pub(crate) struct FitSummaryInput<'a> {
+    /// Runout vector e (mm) and tilt τ (mm/mm, when fitted).
+    pub e: [f64; 2],
+    pub tau: Option<[f64; 2]>,
+    pub cov: &'a FitCovariance,
+    /// Directions of the fitted runout parameters (µm along each), parameters 0..nd.
+    pub runout_dirs: &'a [[f64; 2]],
+    pub coefficients: [f64; 6],
+    pub coefficient_se: [Option<f64>; 6],
+    pub parameters: Vec<String>,
+    /// Unweighted residual and total sums of squares (N²).
+    pub rss: f64,
+    pub tss: f64,
+    pub n: usize,
+    pub np: usize,
+    pub evaluations: usize,
+    pub termination: String,
+    pub converged: bool,
+    pub initial: Option<FrequencyEstimate>,
+    pub disks: usize,
+    pub observability: RunoutObservability,
+    pub has_z: bool,
+}
+
+/// Offsets, angles and their SEs by the delta method (e = Σ t_k d_k, t in µm), R², warnings.
+pub(crate) fn fit_summary(s: FitSummaryInput<'_>) -> FullSignalFit {
+    let np = s.np;
+    let nd = s.runout_dirs.len();
+    let [ex, ey] = s.e;
+    let rho = ex.hypot(ey);
+    // gradient of a function of e, mapped to the parameter vector (µm → mm)
+    let along = |g: [f64; 2]| {
+        let mut v = DVector::zeros(np);
+        for (k, d) in s.runout_dirs.iter().enumerate() {
+            v[k] = (g[0] * d[0] + g[1] * d[1]) * 1e-3;
         }
-    }
-    let rss: f64 = raw.iter().map(|r| r * r).sum();
-    let ill = condition.is_nan() || condition >= 1e8;
+        v
+    };
+    let (g_rho, g_lam) = if rho > 0.0 {
+        ([ex / rho, ey / rho], [-ey / (rho * rho), ex / (rho * rho)])
+    } else {
+        ([f64::NAN; 2], [f64::NAN; 2])
+    };
+    let ill = s.cov.condition.is_nan() || s.cov.condition >= 1e8;
     let mut warnings = Vec::new();
     if ill {
         warnings.push(format!(
-            "ill-conditioned fit (condition number {condition:.3e}): the parameters are not separately identifiable from these recordings (see the correlation matrix); add feeds or components"
+            "ill-conditioned fit (condition number {:.3e}): the parameters are not separately identifiable from these recordings (see the correlation matrix); add feeds or components",
+            s.cov.condition
         ));
     }
-    if !report.termination.was_successful() {
-        warnings.push(format!("solver did not converge: {:?}", report.termination));
+    if !s.converged {
+        warnings.push(format!("solver did not converge: {}", s.termination));
     }
-    if let RunoutObservability::AlongDirection { direction } = observability {
+    if let RunoutObservability::AlongDirection { direction } = s.observability {
         warnings.push(format!(
             "runout only partly observable (K = 2, straight flutes, no tilt): only the component \
              along the tooth line (spindle-frame direction {:.1}°) changes the chip thickness; \
@@ -752,62 +817,68 @@ pub fn full_signal_fit(
             direction[1].atan2(direction[0]).to_degrees()
         ));
     }
-    if tss > 0.0 && rss / tss > 0.1 {
+    let r2 = if s.tss > 0.0 {
+        1.0 - s.rss / s.tss
+    } else {
+        f64::NAN
+    };
+    if s.tss > 0.0 && s.rss / s.tss > 0.1 {
         warnings.push(format!(
-            "poor fit: R² = {:.3} (the model explains < 90 % of the waveform variance) — check the \
-             cut conditions, the axis mapping and the spindle-angle reference",
-            1.0 - rss / tss
+            "poor fit: R² = {r2:.3} (the model explains < 90 % of the waveform variance) — check the \
+             cut conditions, the axis mapping, the spindle-angle reference and the sensor's resonance"
         ));
     }
-    if coef_idx.len() < 6 {
+    if !s.has_z {
         warnings.push("no F_z measured: K_ac and K_ae not identified (fixed at 0)".into());
     }
-    Ok(FullSignalFit {
+    let tilt_se = |k: usize| s.cov.se(nd + k) * 1e-3;
+    FullSignalFit {
         offset: Estimate {
             value: rho,
-            se: Some(quad(g_rho)),
+            se: Some(s.cov.se_of(&along(g_rho))),
         },
         angle: Estimate {
             value: ey.atan2(ex),
-            se: (nd == 2).then(|| quad(g_lam)),
+            se: (nd == 2).then(|| s.cov.se_of(&along(g_lam))),
         },
-        observability,
+        observability: s.observability,
         vector: [
             Estimate {
                 value: ex,
-                se: Some(cov_e[0][0].max(0.0).sqrt()),
+                se: Some(s.cov.se_of(&along([1.0, 0.0]))),
             },
             Estimate {
                 value: ey,
-                se: Some(cov_e[1][1].max(0.0).sqrt()),
+                se: Some(s.cov.se_of(&along([0.0, 1.0]))),
             },
         ],
-        tilt: options.fit_tilt.then(|| {
+        tilt: s.tau.map(|t| {
             [
                 Estimate {
-                    value: problem.x[nd] * 1e-3,
-                    se: Some(se(nd) * 1e-3),
+                    value: t[0],
+                    se: Some(tilt_se(0)),
                 },
                 Estimate {
-                    value: problem.x[nd + 1] * 1e-3,
-                    se: Some(se(nd + 1) * 1e-3),
+                    value: t[1],
+                    se: Some(tilt_se(1)),
                 },
             ]
         }),
-        coefficients,
-        coefficient_se,
-        parameters,
-        correlation,
-        residual_rms_n: (rss / n as f64).sqrt(),
-        r_squared: if tss > 0.0 { 1.0 - rss / tss } else { f64::NAN },
-        condition,
+        coefficients: s.coefficients,
+        coefficient_se: s.coefficient_se,
+        parameters: s.parameters,
+        correlation: s.cov.correlation(),
+        residual_rms_n: (s.rss / s.n as f64).sqrt(),
+        r_squared: r2,
+        condition: s.cov.condition,
         ill_conditioned: ill,
-        n,
-        dof,
-        evaluations: report.number_of_evaluations,
-        termination: format!("{:?}", report.termination),
-        initial,
-        disks,
+        n: s.n,
+        dof: s.n - np,
+        evaluations: s.evaluations,
+        termination: s.termination,
+        initial: s.initial,
+        disks: s.disks,
         warnings,
-    })
+        chain: None,
+    }
 }

@@ -34,9 +34,11 @@
 //! ```
 
 mod alignment;
+mod covariance;
 mod error;
 mod frequency;
 mod full_signal;
+mod harmonic_fit;
 mod lsq;
 mod mean_force;
 mod model;
@@ -50,6 +52,7 @@ pub use alignment::{harmonic_start_angle, model_forces, refine_start_angle, resi
 pub use error::IdentifyError;
 pub use frequency::{frequency_estimate, FrequencyEstimate};
 pub use full_signal::{full_signal_fit, FullSignalFit, FullSignalOptions, RunoutObservability};
+pub use harmonic_fit::{ChainFitReport, ChainModel, ChainOptions, FittedMode};
 pub use lsq::{fit_line, linear_lsq, r_squared, LinearFit, Regression};
 pub use mean_force::{
     calibrate_mean_forces, immersion_integrals, MeanForceCalibration, MeanForces,

@@ -1,0 +1,1093 @@
+//! Full-signal identification through the measuring chain (issue 11): the averaged waveform is
+//! periodic, so the fit works per spindle harmonic k and axis,
+//!
+//! Y_k = H_axis(k·f_rev) · S_k · e^{ikδ} · C_k(e, τ, K),
+//!
+//! where C_k are the harmonics of the rigid cut model ([`RevolutionModel`], the same model as the
+//! time-domain fit), H the measuring chain ([`crate::chain`]: a known FRF or modes, or fitted
+//! modes), S_k = sinc²(πk/n_s) the attenuation of the linear interpolation that resampled the
+//! record (n_s raw samples per revolution) onto the averaging grid (expected value over the
+//! fractional sample positions; 1 when the waveform was not resampled), and δ an optional
+//! spindle-angle correction per recording (without a once-per-revolution reference the angle
+//! origin comes from the tooth-passing phase, which a resonant chain shifts).
+//!
+//! Residuals are the real and imaginary parts of Y_k − X_k (X the measured harmonics) for
+//! k = 0..k_max, scaled so that their sum of squares is the time-domain sum of squares of the
+//! band-limited difference (Parseval), and divided by each component's RMS standard error when
+//! every component carries one. k_max excludes the Nyquist harmonic and is cut by the band limit
+//! and by the range of a measured FRF. A **band-limited** fit is the rigid model on k ≤ k_max
+//! only: the cheap fallback that ignores what the chain does above the band.
+//!
+//! Solution: fitted modes start from a scan of f_n (ζ 0.03) when no start is given; the runout
+//! vector from the frequency-domain estimate and a scan (coefficients solved linearly at every
+//! point, as in the time-domain fit), then Levenberg–Marquardt on all parameters with the smooth
+//! variant of the model, then a compass search of the runout on the exact variant (see the
+//! time-domain fit's docs for why), with the coefficients re-solved linearly.
+
+use super::covariance::{fit_covariance, harmonic_groups};
+use super::error::IdentifyError;
+use super::frequency::frequency_estimate;
+use super::full_signal::{
+    candidate_runouts, compass_search, fit_summary, FitSummaryInput, FullSignalFit,
+    FullSignalOptions, RunoutObservability, NAMES, RUNOUT_STEP_UM,
+};
+use super::lsq::linear_lsq;
+use super::model::{coefficient_gradient, BasisSums, RevolutionModel};
+use super::sine_fit::Estimate;
+use super::waveform::{Axis, WaveformCase};
+use crate::chain::{AxisChain, Complex64, MeasuringChain, SensorMode};
+use crate::coefficients::CuttingCoefficients;
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
+use realfft::RealFftPlanner;
+use serde::Serialize;
+use std::f64::consts::PI;
+
+/// Oversampling L of the model grid: the rigid model is evaluated at L·N angles per revolution,
+/// so that the chain acts on its true harmonics up to L·N/2 before they are folded by the
+/// N-point sampling (a sharp entry or exit has harmonics far above N/2; applying H to the
+/// already-aliased N-point harmonics biased K_te by −3.5 % in the K = 4 down-milling round trip).
+const OVERSAMPLE: usize = 4;
+
+/// How the measuring chain enters the full-signal fit.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ChainModel {
+    /// A known chain (measured FRF, or stated modes), not fitted.
+    Known(MeasuringChain),
+    /// One second-order mode per listed axis, shared by all recordings, fitted (f_n, ζ, gain)
+    /// jointly with runout and coefficients. `None` start values are found by a scan.
+    FitModes {
+        /// Axes with a mode and their start values (`None` = scan f_n, ζ 0.03, gain 1).
+        axes: Vec<(Axis, Option<SensorMode>)>,
+        /// Also fit each mode's relative gain (default: a pure second-order mode, gain 1, whose
+        /// peak height 1/2ζ is then carried by the damping alone).
+        fit_gain: bool,
+    },
+    /// Rigid model on the harmonics 0..=`max_harmonic` of the spindle frequency only.
+    BandLimit {
+        /// Highest spindle harmonic fitted.
+        max_harmonic: usize,
+    },
+}
+
+/// Options of the chain-aware (harmonic) fit, per recording where a vector.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainOptions {
+    /// The chain.
+    pub model: ChainModel,
+    /// Spindle frequency f_rev (Hz) of each recording (measured).
+    pub spindle_hz: Vec<f64>,
+    /// Raw samples per revolution of each recording when its average was resampled by linear
+    /// interpolation (the signal pipeline); `None` = not resampled (S_k = 1).
+    pub samples_per_rev: Vec<Option<f64>>,
+    /// Fit a spindle-angle correction δ for each recording (no absolute angle reference).
+    pub free_start_angle: Vec<bool>,
+}
+
+/// The identified (or given) chain, as reported.
+#[derive(Debug, Clone, Serialize)]
+pub struct ChainFitReport {
+    /// `fitted_modes`, `measured_frf`, `stated_modes` or `band_limit`.
+    pub kind: String,
+    /// Highest spindle harmonic fitted, per recording.
+    pub max_harmonic: Vec<usize>,
+    /// Fitted modes: axis, natural frequency (Hz), damping ratio, gain, each ± SE.
+    pub modes: Vec<FittedMode>,
+    /// Spindle-angle corrections δ (rad) per recording (0 with no SE when not fitted).
+    pub start_angle_shift: Vec<Estimate>,
+    /// R² of the rigid model (chain removed, same band, coefficients re-solved) for comparison.
+    pub rigid_r_squared: f64,
+}
+
+/// One fitted sensor mode.
+#[derive(Debug, Clone, Serialize)]
+pub struct FittedMode {
+    /// Axis of the workpiece frame.
+    pub axis: Axis,
+    /// Natural frequency (Hz).
+    pub frequency_hz: Estimate,
+    /// Damping ratio.
+    pub damping: Estimate,
+    /// Relative gain.
+    pub gain: Estimate,
+}
+
+/// Per-case fixed data: measured harmonics and band.
+#[derive(Clone)]
+struct CaseData {
+    n: usize,
+    kmax: usize,
+    spindle_hz: f64,
+    interp: Vec<f64>,
+    /// Measured harmonics per component (k = 0..=kmax), unnormalised DFT.
+    measured: Vec<Vec<Complex64>>,
+    /// Weight per component (RMS standard error, or 1 N).
+    weight: Vec<f64>,
+    free_angle: Option<usize>,
+}
+
+#[derive(Clone)]
+struct HarmonicProblem<'a> {
+    cases: &'a [WaveformCase],
+    data: Vec<CaseData>,
+    models: Vec<RevolutionModel>,
+    coef_idx: Vec<usize>,
+    fit_tilt: bool,
+    known: Option<MeasuringChain>,
+    /// Fitted modes: axis per mode; parameters (ln f_n, ln ζ, g) in x (logs keep f_n, ζ > 0).
+    mode_axes: Vec<Axis>,
+    fit_gain: bool,
+    /// Gains of the modes when not fitted (kept out of x).
+    fixed_gain: Vec<f64>,
+    /// Parameters: e (µm, 2) [, τ (µm/mm, 2)], coefficients, modes (3 each), δ (rad) per free case.
+    x: DVector<f64>,
+    /// Harmonics of the six basis sums per case: [r][k].
+    basis: Vec<Vec<Vec<Complex64>>>,
+    planner_cache: Vec<std::sync::Arc<dyn realfft::RealToComplex<f64>>>,
+    /// Rigid comparison: chain switched off (band kept).
+    rigid: bool,
+    /// Leave the runout columns of the Jacobian empty ([`RestProblem`]).
+    freeze_runout: bool,
+    /// Use only the harmonics k ≡ 0 (mod this number of teeth): to first order in ρ the runout
+    /// adds nothing there (Σ_i cos(λ + 2πi/K) terms cancel), so the mode scan sees the chain
+    /// without the runout misfit, which dominates the cost before the runout is found.
+    tooth_harmonics_only: Option<usize>,
+}
+
+/// The fit with the runout held: coefficients, chain parameters and angle shifts only. On the
+/// exact model (edge forces only where h > 0) the residuals are smooth in these, so LM works
+/// there; the smooth model's edge forces where h ≤ 0 (e.g. near a down-milling exit, where the
+/// smaller teeth's chip vanishes) otherwise leak into the damping (ζ 0.040 for 0.030).
+struct RestProblem<'a> {
+    p: HarmonicProblem<'a>,
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for RestProblem<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, x: &DVector<f64>) {
+        let nr = self.p.n_runout();
+        self.p.x.rows_mut(nr, x.len()).copy_from(x);
+    }
+    fn params(&self) -> DVector<f64> {
+        let nr = self.p.n_runout();
+        self.p.x.rows(nr, self.p.x.len() - nr).into_owned()
+    }
+    fn residuals(&self) -> Option<DVector<f64>> {
+        self.p.residuals()
+    }
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let nr = self.p.n_runout();
+        let j = self.p.jacobian()?;
+        Some(j.columns(nr, j.ncols() - nr).into_owned())
+    }
+}
+
+/// Alternate, on the exact model, a compass search of the runout (coefficients linear, the rest
+/// held) and LM on everything but the runout; three times. Returns the evaluations.
+/// Modes in `rescan` (those without a start value) are scanned again after each compass search:
+/// with the runout close, a mode left in a local minimum by stage 1 (K = 2 at low feeds: y at
+/// 7.6 kHz for 1.1 kHz) is found by its own scan.
+fn refine_on_exact_model(
+    p: &mut HarmonicProblem<'_>,
+    rescan: &[usize],
+    teeth: usize,
+) -> Result<usize, IdentifyError> {
+    let nr = p.n_runout();
+    p.set_smooth(false);
+    let dirs: Vec<Vec<f64>> = (0..nr)
+        .map(|k| (0..nr).map(|j| if j == k { 1.0 } else { 0.0 }).collect())
+        .collect();
+    let mut evals = 0;
+    for round in 0..3 {
+        let step = if round == 0 {
+            (0.05 * p.x[0].hypot(p.x[1])).max(0.5)
+        } else {
+            0.1
+        };
+        let x_runout: Vec<f64> = (0..nr).map(|i| p.x[i]).collect();
+        let (xr, e) = compass_search(&x_runout, &dirs, step, |t| {
+            for (i, v) in t.iter().enumerate() {
+                p.x[i] = *v;
+            }
+            p.recompute();
+            p.profile_cost()
+        });
+        evals += e;
+        for (i, v) in xr.iter().enumerate() {
+            p.x[i] = *v;
+        }
+        p.recompute();
+        for &m in rescan {
+            scan_modes(p, &[m], teeth, false);
+        }
+        p.linear_coefficients()?;
+        let mut rest = p.clone();
+        rest.freeze_runout = true;
+        let before = p.residual_vec().iter().map(|r| r * r).sum::<f64>();
+        let (done, report) = LevenbergMarquardt::new()
+            .with_patience(100)
+            .minimize(RestProblem { p: rest });
+        evals += report.number_of_evaluations;
+        let after = 2.0 * report.objective_function;
+        if !(done.p.x.iter().all(|v| v.is_finite()) && after <= before) {
+            continue; // keep the compass result
+        }
+        let mut q = done.p;
+        q.freeze_runout = false;
+        *p = q;
+    }
+    Ok(evals)
+}
+
+impl HarmonicProblem<'_> {
+    fn n_runout(&self) -> usize {
+        if self.fit_tilt {
+            4
+        } else {
+            2
+        }
+    }
+    fn coef_start(&self) -> usize {
+        self.n_runout()
+    }
+    fn mode_start(&self) -> usize {
+        self.n_runout() + self.coef_idx.len()
+    }
+    /// Parameters per mode: ln f_n, ln ζ [, gain].
+    fn per_mode(&self) -> usize {
+        if self.fit_gain {
+            3
+        } else {
+            2
+        }
+    }
+    fn mode_offset(&self, m: usize) -> usize {
+        self.mode_start() + self.per_mode() * m
+    }
+    fn angle_start(&self) -> usize {
+        self.mode_start() + self.per_mode() * self.mode_axes.len()
+    }
+    fn set_gain(&mut self, m: usize, g: f64) {
+        if self.fit_gain {
+            let o = self.mode_offset(m) + 2;
+            self.x[o] = g;
+        } else {
+            self.fixed_gain[m] = g;
+        }
+    }
+    fn runout(&self) -> ([f64; 2], [f64; 2]) {
+        let e = [self.x[0] * 1e-3, self.x[1] * 1e-3];
+        let t = if self.fit_tilt {
+            [self.x[2] * 1e-3, self.x[3] * 1e-3]
+        } else {
+            [0.0; 2]
+        };
+        (e, t)
+    }
+    fn set_runout(&mut self, e: [f64; 2]) {
+        self.x[0] = e[0] * 1e3;
+        self.x[1] = e[1] * 1e3;
+    }
+    fn coefficients(&self) -> CuttingCoefficients {
+        let mut a = [0.0; 6];
+        for (p, &i) in self.coef_idx.iter().enumerate() {
+            a[i] = self.x[self.coef_start() + p];
+        }
+        CuttingCoefficients::from_array(a)
+    }
+    fn mode(&self, m: usize) -> SensorMode {
+        let o = self.mode_offset(m);
+        // bounded so that a wild solver step cannot overflow: 1 Hz..10 MHz, ζ 1e-4..2
+        SensorMode {
+            frequency_hz: self.x[o].clamp(0.0, 16.1).exp(),
+            damping: self.x[o + 1].clamp(-9.2, 0.7).exp(),
+            gain: if self.fit_gain {
+                self.x[o + 2]
+            } else {
+                self.fixed_gain[m]
+            },
+        }
+    }
+    fn set_smooth(&mut self, smooth: bool) {
+        for m in &mut self.models {
+            m.edge_in_window = smooth;
+        }
+        self.recompute();
+    }
+    /// Basis sums and their harmonics at the current runout.
+    fn recompute(&mut self) {
+        let (e, t) = self.runout();
+        self.basis = (0..self.models.len())
+            .map(|c| {
+                let s = self.models[c].base_sums(e, t);
+                self.basis_harmonics(c, &s)
+            })
+            .collect();
+    }
+    /// Harmonics 0..=L·N/2 of the six basis sums on the oversampled grid, scaled by 1/L so that
+    /// they compare with an N-point DFT.
+    fn basis_harmonics(&self, c: usize, s: &BasisSums) -> Vec<Vec<Complex64>> {
+        let fft = &self.planner_cache[c];
+        (0..6)
+            .map(|r| {
+                let mut buf: Vec<f64> = s.base.iter().map(|b| b[r]).collect();
+                let mut out = fft.make_output_vec();
+                fft.process(&mut buf, &mut out).expect("fft length");
+                out.iter().map(|v| v / OVERSAMPLE as f64).collect()
+            })
+            .collect()
+    }
+    /// What N-point sampling makes of a real signal with harmonics Y_m (m = 0..=L·N/2) at
+    /// harmonic k, times the resampling attenuation S_k:
+    /// X_k = S_k·(Σ_{j≥0} Y_{k+jN} + Σ_{j≥1} conj(Y_{jN−k})).
+    fn fold(&self, c: usize, k: usize, y: impl Fn(usize) -> Complex64) -> Complex64 {
+        let d = &self.data[c];
+        let top = OVERSAMPLE * d.n / 2;
+        let mut sum = Complex64::new(0.0, 0.0);
+        let mut m = k;
+        while m <= top {
+            sum += y(m);
+            m += d.n;
+        }
+        let mut m = d.n;
+        while m >= k && m - k <= top {
+            sum += y(m - k).conj();
+            m += d.n;
+        }
+        sum * d.interp[k]
+    }
+    /// H(m·f_rev)·e^{imδ} of case c, axis, true harmonic m (only e^{imδ} for the rigid
+    /// comparison). A measured FRF is held at its last value above its range.
+    fn factor(&self, c: usize, axis: Axis, k: usize) -> Complex64 {
+        let d = &self.data[c];
+        let mut h = Complex64::new(1.0, 0.0);
+        if let Some(i) = d.free_angle {
+            let delta = self.x[self.angle_start() + i];
+            h *= Complex64::from_polar(1.0, k as f64 * delta);
+        }
+        if self.rigid {
+            return h;
+        }
+        let f = k as f64 * d.spindle_hz;
+        if let Some(chain) = &self.known {
+            h *= chain.axis(axis).response_clamped(f);
+        }
+        if let Some(m) = self.mode_axes.iter().position(|&a| a == axis) {
+            let mode = self.mode(m);
+            h *= Complex64::new(1.0 - mode.gain, 0.0) + mode.unit_response(f) * mode.gain;
+        }
+        h
+    }
+    /// Rigid-model harmonic of the coefficient-gradient column i (K order) for axis.
+    fn gradient_harmonic(&self, c: usize, axis: Axis, k: usize) -> [Complex64; 6] {
+        let b = &self.basis[c];
+        let mut re = [0.0; 6];
+        let mut im = [0.0; 6];
+        for r in 0..6 {
+            re[r] = b[r][k].re;
+            im[r] = b[r][k].im;
+        }
+        let gr = coefficient_gradient(axis, &re);
+        let gi = coefficient_gradient(axis, &im);
+        std::array::from_fn(|i| Complex64::new(gr[i], gi[i]))
+    }
+    /// Rigid-model harmonic m (true, oversampled) for axis.
+    fn model_harmonic(&self, c: usize, axis: Axis, m: usize, kc: &[f64; 6]) -> Complex64 {
+        let g = self.gradient_harmonic(c, axis, m);
+        (0..6).map(|i| g[i] * kc[i]).sum()
+    }
+    /// Measured model harmonic k: chain and angle shift on the true harmonics, then sampling.
+    fn measured_model(&self, c: usize, axis: Axis, k: usize, kc: &[f64; 6]) -> Complex64 {
+        self.fold(c, k, |m| {
+            self.factor(c, axis, m) * self.model_harmonic(c, axis, m, kc)
+        })
+    }
+    fn n_residuals(&self) -> usize {
+        let mut n = 0;
+        self.rows(|_, _, k, _| n += if k > 0 { 2 } else { 1 });
+        n
+    }
+    /// Visit every residual row: (case, component index, harmonic, scale of re/im rows).
+    fn rows(&self, mut f: impl FnMut(usize, usize, usize, f64)) {
+        for (c, d) in self.data.iter().enumerate() {
+            for comp in 0..d.measured.len() {
+                for k in 0..=d.kmax {
+                    if self.tooth_harmonics_only.is_some_and(|t| k % t != 0) {
+                        continue;
+                    }
+                    let s = if k == 0 { 1.0 } else { 2f64.sqrt() }
+                        / (d.n as f64).sqrt()
+                        / d.weight[comp];
+                    f(c, comp, k, s);
+                }
+            }
+        }
+    }
+    /// Push the rows of a complex value (re, and im for k > 0).
+    fn push(out: &mut Vec<f64>, v: Complex64, k: usize, s: f64) {
+        out.push(v.re * s);
+        if k > 0 {
+            out.push(v.im * s);
+        }
+    }
+    fn residual_vec(&self) -> Vec<f64> {
+        let kc = self.coefficients().to_array();
+        let mut out = Vec::with_capacity(self.n_residuals());
+        self.rows(|c, comp, k, s| {
+            let axis = self.cases[c].waveform.components[comp].axis;
+            let y = self.measured_model(c, axis, k, &kc);
+            Self::push(&mut out, y - self.data[c].measured[comp][k], k, s);
+        });
+        out
+    }
+    /// Measured rows (for R²) and the per-row "mean" part (k = 0 rows).
+    fn measured_rows(&self) -> (Vec<f64>, Vec<bool>) {
+        let mut out = Vec::new();
+        let mut dc = Vec::new();
+        self.rows(|c, comp, k, s| {
+            Self::push(&mut out, self.data[c].measured[comp][k], k, s);
+            dc.resize(out.len(), k == 0);
+        });
+        (out, dc)
+    }
+    /// Design matrix of the coefficients (chain included) and the measured rows.
+    fn coefficient_design(&self) -> DMatrix<f64> {
+        let n = self.n_residuals();
+        let mut x = DMatrix::zeros(n, self.coef_idx.len());
+        let mut row = 0;
+        self.rows(|c, comp, k, s| {
+            let axis = self.cases[c].waveform.components[comp].axis;
+            for (j, &i) in self.coef_idx.iter().enumerate() {
+                let v = self.fold(c, k, |m| {
+                    self.factor(c, axis, m) * self.gradient_harmonic(c, axis, m)[i]
+                });
+                x[(row, j)] = v.re * s;
+                if k > 0 {
+                    x[(row + 1, j)] = v.im * s;
+                }
+            }
+            row += if k > 0 { 2 } else { 1 };
+        });
+        x
+    }
+    fn linear_coefficients(&mut self) -> Result<(), IdentifyError> {
+        let x = self.coefficient_design();
+        let (y, _) = self.measured_rows();
+        let fit = linear_lsq("coefficients", &x, &DVector::from_vec(y))?;
+        let c0 = self.coef_start();
+        for c in 0..self.coef_idx.len() {
+            self.x[c0 + c] = fit.beta[c];
+        }
+        Ok(())
+    }
+    fn profile_cost(&mut self) -> f64 {
+        match self.linear_coefficients() {
+            Ok(()) => self.residual_vec().iter().map(|r| r * r).sum(),
+            Err(_) => f64::INFINITY,
+        }
+    }
+    /// Columns of the chain parameters and angle shifts, analytic.
+    fn chain_columns(&self, j: &mut DMatrix<f64>) {
+        let kc = self.coefficients().to_array();
+        let as_ = self.angle_start();
+        let mut row = 0;
+        self.rows(|c, comp, k, s| {
+            let axis = self.cases[c].waveform.components[comp].axis;
+            let mut put = |col: usize, v: Complex64| {
+                j[(row, col)] = v.re * s;
+                if k > 0 {
+                    j[(row + 1, col)] = v.im * s;
+                }
+            };
+            let y = |m: usize| self.factor(c, axis, m) * self.model_harmonic(c, axis, m, &kc);
+            if let Some(mi) = self.mode_axes.iter().position(|&a| a == axis) {
+                let mode = self.mode(mi);
+                let f = |m: usize| m as f64 * self.data[c].spindle_hz;
+                // everything but this mode's factor, times the derivative of that factor
+                let rest = |m: usize| {
+                    let h =
+                        Complex64::new(1.0 - mode.gain, 0.0) + mode.unit_response(f(m)) * mode.gain;
+                    y(m) / h
+                };
+                let o = self.mode_offset(mi);
+                // parameters ln f_n, ln ζ: ∂/∂ln x = x·∂/∂x
+                put(
+                    o,
+                    self.fold(c, k, |m| {
+                        rest(m)
+                            * mode.unit_response_derivatives(f(m)).0
+                            * mode.gain
+                            * mode.frequency_hz
+                    }),
+                );
+                put(
+                    o + 1,
+                    self.fold(c, k, |m| {
+                        rest(m) * mode.unit_response_derivatives(f(m)).1 * mode.gain * mode.damping
+                    }),
+                );
+                if self.fit_gain {
+                    put(
+                        o + 2,
+                        self.fold(c, k, |m| rest(m) * (mode.unit_response(f(m)) - 1.0)),
+                    );
+                }
+            }
+            if let Some(i) = self.data[c].free_angle {
+                put(
+                    as_ + i,
+                    self.fold(c, k, |m| y(m) * Complex64::new(0.0, m as f64)),
+                );
+            }
+            row += if k > 0 { 2 } else { 1 };
+        });
+    }
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for HarmonicProblem<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, x: &DVector<f64>) {
+        let moved = (0..self.n_runout()).any(|i| x[i] != self.x[i]);
+        self.x.copy_from(x);
+        if moved || self.basis.is_empty() {
+            self.recompute();
+        }
+    }
+    fn params(&self) -> DVector<f64> {
+        self.x.clone()
+    }
+    fn residuals(&self) -> Option<DVector<f64>> {
+        let r = DVector::from_vec(self.residual_vec());
+        r.iter().all(|v| v.is_finite()).then_some(r)
+    }
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let n = self.n_residuals();
+        let np = self.x.len();
+        let mut j = DMatrix::zeros(n, np);
+        // runout columns: central differences (see RUNOUT_STEP_UM)
+        let runout_cols = if self.freeze_runout {
+            0
+        } else {
+            self.n_runout()
+        };
+        for p in 0..runout_cols {
+            let mut plus = self.clone();
+            plus.x[p] += RUNOUT_STEP_UM;
+            plus.recompute();
+            let mut minus = self.clone();
+            minus.x[p] -= RUNOUT_STEP_UM;
+            minus.recompute();
+            for (r, (a, b)) in plus
+                .residual_vec()
+                .iter()
+                .zip(minus.residual_vec())
+                .enumerate()
+            {
+                j[(r, p)] = (a - b) / (2.0 * RUNOUT_STEP_UM);
+            }
+        }
+        let design = self.coefficient_design();
+        j.columns_mut(self.coef_start(), self.coef_idx.len())
+            .copy_from(&design);
+        self.chain_columns(&mut j);
+        j.iter().all(|v| v.is_finite()).then_some(j)
+    }
+}
+
+/// Highest harmonic of case c: below Nyquist, within a band limit and a measured FRF's range.
+fn max_harmonic(n: usize, spindle_hz: f64, model: &ChainModel, axes: &[Axis]) -> usize {
+    let mut kmax = (n - 1) / 2;
+    match model {
+        ChainModel::BandLimit { max_harmonic } => kmax = kmax.min(*max_harmonic),
+        ChainModel::Known(chain) => {
+            for &a in axes {
+                if let AxisChain::Frf(f) = chain.axis(a) {
+                    kmax = kmax.min((f.max_frequency_hz() / spindle_hz).floor() as usize);
+                }
+            }
+        }
+        ChainModel::FitModes { .. } => {}
+    }
+    kmax
+}
+
+fn case_data(
+    case: &WaveformCase,
+    opts: &ChainOptions,
+    c: usize,
+    free_index: Option<usize>,
+    planner: &mut RealFftPlanner<f64>,
+) -> Result<CaseData, IdentifyError> {
+    let n = case.waveform.validate()?;
+    let spindle_hz = opts.spindle_hz[c];
+    if !(spindle_hz.is_finite() && spindle_hz > 0.0) {
+        return Err(IdentifyError::too_few(
+            "chain fit",
+            "a spindle frequency > 0 Hz per recording",
+            spindle_hz,
+        ));
+    }
+    let axes: Vec<Axis> = case.waveform.components.iter().map(|k| k.axis).collect();
+    let kmax = max_harmonic(n, spindle_hz, &opts.model, &axes);
+    let fft = planner.plan_fft_forward(n);
+    let measured = case
+        .waveform
+        .components
+        .iter()
+        .map(|comp| {
+            let mut buf = comp.values.clone();
+            let mut out = fft.make_output_vec();
+            fft.process(&mut buf, &mut out).expect("fft length");
+            out.truncate(kmax + 1);
+            out
+        })
+        .collect();
+    let weight = case
+        .waveform
+        .components
+        .iter()
+        .map(|comp| {
+            comp.se.as_ref().map_or(1.0, |s| {
+                (s.iter().map(|v| v * v).sum::<f64>() / s.len() as f64).sqrt()
+            })
+        })
+        .collect::<Vec<f64>>();
+    let all_se = case.waveform.components.iter().all(|k| k.se.is_some());
+    let interp = (0..=kmax)
+        .map(|k| match opts.samples_per_rev[c] {
+            Some(spr) if k > 0 => {
+                let x = PI * k as f64 / spr;
+                (x.sin() / x).powi(2)
+            }
+            _ => 1.0,
+        })
+        .collect();
+    Ok(CaseData {
+        n,
+        kmax,
+        spindle_hz,
+        interp,
+        measured,
+        weight: if all_se {
+            weight
+        } else {
+            vec![1.0; axes.len()]
+        },
+        free_angle: free_index,
+    })
+}
+
+/// Start values of the modes without one: a scan of f_n from the tooth-passing frequency to
+/// 0.9 × Nyquist (121 log-spaced points, ζ 0.03 and 0.1 — a broad mode finds a resonance between
+/// two harmonics that a sharp one misses — gain 1), coefficients solved linearly at each point:
+/// first one frequency shared by all those modes (every axis's evidence at once), then each
+/// mode on its own, kept only where it lowers the cost (axes with different modes).
+/// Returns true when the scan lowered the cost below that of the current values.
+fn scan_modes(p: &mut HarmonicProblem<'_>, which: &[usize], teeth: usize, per_axis: bool) -> bool {
+    if which.is_empty() {
+        return false;
+    }
+    let current: Vec<(f64, f64)> = which
+        .iter()
+        .map(|&m| (p.x[p.mode_offset(m)], p.x[p.mode_offset(m) + 1]))
+        .collect();
+    let gains: Vec<f64> = which.iter().map(|&m| p.mode(m).gain).collect();
+    let start_cost = p.profile_cost();
+    let lo = p
+        .data
+        .iter()
+        .map(|d| d.spindle_hz * teeth as f64)
+        .fold(f64::INFINITY, f64::min);
+    let hi = p
+        .data
+        .iter()
+        .map(|d| 0.9 * d.spindle_hz * d.kmax as f64)
+        .fold(0.0, f64::max)
+        .max(2.0 * lo);
+    let grid: Vec<(f64, f64)> = [0.03f64, 0.1]
+        .iter()
+        .flat_map(|&z| (0..=120).map(move |s| (lo * (hi / lo).powf(s as f64 / 120.0), z)))
+        .collect();
+    let set = |p: &mut HarmonicProblem<'_>, ms: &[usize], f: f64, z: f64| {
+        for &m in ms {
+            let o = p.mode_offset(m);
+            p.x[o] = f.ln();
+            p.x[o + 1] = z.ln();
+            p.set_gain(m, 1.0);
+        }
+    };
+    let scan = |p: &mut HarmonicProblem<'_>, ms: &[usize], mut best: (f64, f64, f64)| {
+        for &(f, z) in &grid {
+            set(p, ms, f, z);
+            let c = p.profile_cost();
+            if c < best.0 {
+                best = (c, f, z);
+            }
+        }
+        set(p, ms, best.1, best.2);
+        best
+    };
+    let joint = scan(p, which, (f64::INFINITY, lo, 0.03));
+    let improved = |p: &mut HarmonicProblem<'_>, best: f64| {
+        if best < start_cost * (1.0 - 1e-3) {
+            return true;
+        }
+        for (i, &m) in which.iter().enumerate() {
+            let o = p.mode_offset(m);
+            p.x[o] = current[i].0;
+            p.x[o + 1] = current[i].1;
+            p.set_gain(m, gains[i]);
+        }
+        false
+    };
+    if !per_axis {
+        return improved(p, joint.0);
+    }
+    for &m in which {
+        let here = (joint.0, joint.1, joint.2);
+        let best = scan(p, &[m], here);
+        set(p, &[m], best.1, best.2);
+    }
+    let end = p.profile_cost();
+    improved(p, end)
+}
+
+/// Profile cost at each candidate runout vector (the rest of x as it is), best first.
+fn scan_runouts(p: &mut HarmonicProblem<'_>, candidates: &[[f64; 2]]) -> Vec<(f64, DVector<f64>)> {
+    let mut scored: Vec<(f64, DVector<f64>)> = Vec::new();
+    for &e in candidates {
+        p.set_runout(e);
+        p.recompute();
+        let c = p.profile_cost();
+        if c.is_finite() {
+            scored.push((c, p.x.clone()));
+        }
+    }
+    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    scored
+}
+
+/// The chain-aware full-signal fit; called by [`super::full_signal_fit`] when
+/// [`FullSignalOptions::chain`] is set.
+pub(crate) fn harmonic_fit(
+    cases: &[WaveformCase],
+    options: &FullSignalOptions,
+    chain: &ChainOptions,
+    disks: usize,
+) -> Result<FullSignalFit, IdentifyError> {
+    let nc = cases.len();
+    if chain.spindle_hz.len() != nc
+        || chain.samples_per_rev.len() != nc
+        || chain.free_start_angle.len() != nc
+    {
+        return Err(IdentifyError::too_few(
+            "chain fit",
+            format!("spindle speed, samples per revolution and angle flag for {nc} recordings"),
+            chain.spindle_hz.len(),
+        ));
+    }
+    let mut planner = RealFftPlanner::<f64>::new();
+    let mut free = 0;
+    let mut data = Vec::with_capacity(nc);
+    for (c, case) in cases.iter().enumerate() {
+        let idx = chain.free_start_angle[c].then(|| {
+            free += 1;
+            free - 1
+        });
+        data.push(case_data(case, chain, c, idx, &mut planner)?);
+    }
+    let has_z = cases
+        .iter()
+        .any(|c| c.waveform.components.iter().any(|k| k.axis == Axis::Z));
+    let coef_idx: Vec<usize> = if has_z {
+        vec![0, 1, 2, 3, 4, 5]
+    } else {
+        vec![0, 1, 3, 4]
+    };
+    type ModeStarts = Vec<(Axis, Option<SensorMode>)>;
+    let (known, mode_starts, fit_gain): (Option<MeasuringChain>, ModeStarts, bool) =
+        match &chain.model {
+            ChainModel::Known(c) => (Some(c.clone()), vec![], false),
+            ChainModel::FitModes { axes, fit_gain } => (None, axes.clone(), *fit_gain),
+            ChainModel::BandLimit { .. } => (None, vec![], false),
+        };
+    let nr = if options.fit_tilt { 4 } else { 2 };
+    let per_mode = if fit_gain { 3 } else { 2 };
+    let np = nr + coef_idx.len() + per_mode * mode_starts.len() + free;
+    let models: Vec<RevolutionModel> = cases
+        .iter()
+        .map(|c| {
+            RevolutionModel::new(
+                &c.cutter,
+                &c.cut,
+                c.waveform.start_angle,
+                OVERSAMPLE * c.waveform.samples(),
+                disks,
+            )
+        })
+        .collect();
+    let planner_cache = data
+        .iter()
+        .map(|d| planner.plan_fft_forward(OVERSAMPLE * d.n))
+        .collect();
+    let mut p = HarmonicProblem {
+        cases,
+        data,
+        models,
+        coef_idx: coef_idx.clone(),
+        fit_tilt: options.fit_tilt,
+        known,
+        mode_axes: mode_starts.iter().map(|m| m.0).collect(),
+        fit_gain,
+        fixed_gain: vec![1.0; mode_starts.len()],
+        x: DVector::zeros(np),
+        basis: Vec::new(),
+        planner_cache,
+        rigid: false,
+        freeze_runout: false,
+        tooth_harmonics_only: None,
+    };
+    let n = p.n_residuals();
+    if n <= np {
+        return Err(IdentifyError::too_few(
+            "chain fit",
+            format!("more than {np} harmonic residuals (raise the band limit)"),
+            n,
+        ));
+    }
+    // modes without a start value begin switched off (gain 0) until their scan
+    for (m, (_, start)) in mode_starts.iter().enumerate() {
+        let s = start.unwrap_or(SensorMode {
+            frequency_hz: 1000.0,
+            damping: 0.03,
+            gain: 0.0,
+        });
+        let o = p.mode_offset(m);
+        p.x[o] = s.frequency_hz.ln();
+        p.x[o + 1] = s.damping.ln();
+        p.set_gain(m, s.gain);
+    }
+    // Start values: runout from the frequency-domain estimate (harmonic 1 is far below any
+    // sensor mode), coefficients linear; modes without a start value scanned; then the runout scan.
+    p.set_smooth(true);
+    p.linear_coefficients()?;
+    let mut e_start = options.initial_runout.unwrap_or([0.0; 2]);
+    let initial = frequency_estimate(cases, &p.coefficients(), disks).ok();
+    if let (Some(f), None) = (initial, options.initial_runout) {
+        e_start = f.vector;
+    }
+    p.set_runout(e_start);
+    p.recompute();
+    let teeth = cases[0].cutter.teeth();
+    // Mode scans first, at zero runout: the chain shapes the tooth-passing harmonics, which the
+    // runout hardly changes, while a runout start from the frequency estimate can be far off on
+    // resonant data (46 µm for 10 µm in the K = 2 round trip) and a sharp mode scanned there
+    // loses to a broad one. Then the runout scan with the modes in (rings of 3, 10 and 30 µm
+    // besides the usual ones around the start values).
+    let unstarted: Vec<usize> = (0..mode_starts.len())
+        .filter(|&m| mode_starts[m].1.is_none())
+        .collect();
+    if !unstarted.is_empty() {
+        p.set_runout([0.0; 2]);
+        p.recompute();
+        p.tooth_harmonics_only = Some(teeth);
+        scan_modes(&mut p, &unstarted, teeth, false);
+        p.tooth_harmonics_only = None;
+    }
+    let mut candidates = vec![e_start];
+    if let Some(f) = initial {
+        candidates.push(f.vector);
+    }
+    candidates.extend(candidate_runouts(&candidates));
+    for r in [0.003, 0.010, 0.030] {
+        candidates.extend(
+            candidate_runouts(&[[r / 1.5, 0.0]])
+                .into_iter()
+                .skip(16)
+                .take(16),
+        );
+    }
+    let mut starts = Vec::new();
+    let scored = scan_runouts(&mut p, &candidates);
+    if unstarted.is_empty() {
+        // LM from the best scan point, and from the second when its cost is comparable (2×):
+        // with edge skipping (large ρ, K = 2) the cost has local minima
+        let best = scored.first().map_or(f64::INFINITY, |s| s.0);
+        starts.extend(scored.into_iter().take(2).filter(|s| s.0 <= 2.0 * best));
+    } else {
+        // At low feeds the runout clips the smaller tooth's chip, which changes the tooth
+        // harmonics too: scan the modes again at the best runout (all harmonics), once with one
+        // frequency for all axes and once per axis (axes with different modes), then the runout
+        // again; LM from both.
+        for per_axis in [false, true] {
+            if let Some((_, x)) = scored.first() {
+                p.x.copy_from(x);
+                p.recompute();
+            }
+            scan_modes(&mut p, &unstarted, teeth, per_axis);
+            if let Some(best) = scan_runouts(&mut p, &candidates).into_iter().next() {
+                starts.push(best);
+            }
+        }
+    }
+    let mut best: Option<(
+        HarmonicProblem<'_>,
+        levenberg_marquardt::MinimizationReport<f64>,
+    )> = None;
+    for (_, x) in &starts {
+        let mut start = p.clone();
+        start.x.copy_from(x);
+        start.recompute();
+        let (done, report) = LevenbergMarquardt::new().with_patience(200).minimize(start);
+        if best
+            .as_ref()
+            .is_none_or(|(_, r)| report.objective_function < r.objective_function)
+        {
+            best = Some((done, report));
+        }
+    }
+    let (mut p, report) =
+        best.ok_or_else(|| IdentifyError::singular("chain fit", "no valid start value"))?;
+    // Stage 2: exact model (see [`refine_on_exact_model`]).
+    let evals = refine_on_exact_model(&mut p, &unstarted, teeth)?;
+    let raw = p.residual_vec();
+    // Covariance: Jacobian on the smooth model at the solution (see the time-domain fit).
+    // (runout columns from the smooth model: the exact model's differences also catch its
+    // edge-force steps, which carry no information per sample; the rest from the exact model).
+    let mut smooth = p.clone();
+    smooth.set_smooth(true);
+    let singular = || IdentifyError::singular("chain fit", "non-finite Jacobian");
+    let mut jac = p.jacobian().ok_or_else(singular)?;
+    let js = smooth.jacobian().ok_or_else(singular)?;
+    jac.columns_mut(0, nr).copy_from(&js.columns(0, nr));
+    let res = DVector::from_vec(raw.clone());
+    let groups = harmonic_groups(&p.data.iter().map(|d| d.kmax).collect::<Vec<_>>(), &{
+        cases
+            .iter()
+            .map(|c| c.waveform.components.len())
+            .collect::<Vec<_>>()
+    });
+    let cov = fit_covariance(&jac, &res, &groups);
+    // R² of the band about each component's mean: the k = 0 rows are the means.
+    let (meas, dc) = p.measured_rows();
+    let tss: f64 = meas
+        .iter()
+        .zip(&dc)
+        .filter(|(_, d)| !**d)
+        .map(|(v, _)| v * v)
+        .sum();
+    let rss: f64 = raw.iter().map(|r| r * r).sum();
+    // Rigid comparison: same band, chain off, coefficients and runout re-solved linearly at the
+    // chain fit's runout (profile), angle shifts kept.
+    let mut rig = p.clone();
+    rig.rigid = true;
+    let rigid_rss = rig.profile_cost();
+    let rigid_r2 = 1.0 - rigid_rss / tss;
+
+    let mut names: Vec<String> = vec!["ex_um".into(), "ey_um".into()];
+    if options.fit_tilt {
+        names.extend(["tilt_x_um_per_mm".into(), "tilt_y_um_per_mm".into()]);
+    }
+    names.extend(coef_idx.iter().map(|&i| NAMES[i].to_string()));
+    for a in &p.mode_axes {
+        let ax = format!("{a:?}").to_lowercase();
+        names.extend([format!("mode_{ax}_ln_hz"), format!("mode_{ax}_ln_damping")]);
+        if fit_gain {
+            names.push(format!("mode_{ax}_gain"));
+        }
+    }
+    for (c, d) in p.data.iter().enumerate() {
+        if d.free_angle.is_some() {
+            names.push(format!("start_angle_shift_{c}_rad"));
+        }
+    }
+    let se = |i: usize| cov.se(i);
+    let modes = (0..p.mode_axes.len())
+        .map(|m| {
+            let o = p.mode_offset(m);
+            FittedMode {
+                axis: p.mode_axes[m],
+                frequency_hz: Estimate {
+                    value: p.x[o].exp(),
+                    se: Some(se(o) * p.x[o].exp()),
+                },
+                damping: Estimate {
+                    value: p.x[o + 1].exp(),
+                    se: Some(se(o + 1) * p.x[o + 1].exp()),
+                },
+                gain: Estimate {
+                    value: p.mode(m).gain,
+                    se: fit_gain.then(|| se(o + 2)),
+                },
+            }
+        })
+        .collect();
+    let shifts = p
+        .data
+        .iter()
+        .map(|d| match d.free_angle {
+            Some(i) => Estimate {
+                value: p.x[p.angle_start() + i],
+                se: Some(se(p.angle_start() + i)),
+            },
+            None => Estimate {
+                value: 0.0,
+                se: None,
+            },
+        })
+        .collect();
+    let kind = match &chain.model {
+        ChainModel::FitModes { .. } => "fitted_modes",
+        ChainModel::BandLimit { .. } => "band_limit",
+        ChainModel::Known(c)
+            if [&c.x, &c.y, &c.z]
+                .iter()
+                .any(|a| matches!(a, AxisChain::Frf(_))) =>
+        {
+            "measured_frf"
+        }
+        ChainModel::Known(_) => "stated_modes",
+    };
+    let report_chain = ChainFitReport {
+        kind: kind.into(),
+        max_harmonic: p.data.iter().map(|d| d.kmax).collect(),
+        modes,
+        start_angle_shift: shifts,
+        rigid_r_squared: rigid_r2,
+    };
+    let (e, tau) = p.runout();
+    let mut coefficients = [0.0; 6];
+    let mut coefficient_se = [None; 6];
+    for (j, &i) in coef_idx.iter().enumerate() {
+        coefficients[i] = p.x[nr + j];
+        coefficient_se[i] = Some(se(nr + j));
+    }
+    let mut fit = fit_summary(FitSummaryInput {
+        e,
+        tau: options.fit_tilt.then_some(tau),
+        cov: &cov,
+        runout_dirs: &[[1.0, 0.0], [0.0, 1.0]],
+        coefficients,
+        coefficient_se,
+        parameters: names,
+        rss,
+        tss,
+        n,
+        np,
+        evaluations: report.number_of_evaluations + evals,
+        termination: format!("{:?}", report.termination),
+        converged: report.termination.was_successful(),
+        initial,
+        disks,
+        observability: RunoutObservability::Full,
+        has_z,
+    });
+    fit.chain = Some(report_chain);
+    Ok(fit)
+}
