@@ -183,6 +183,7 @@ fn synthetic(before: f64, cut: f64, after: f64) -> (Vec<Vec<f64>>, (usize, usize
         drift_mm: 0.0005,
         ramp_revolutions: 2.0,
         pulse: false,
+        chain: Default::default(),
     };
     let mut k = 0u64;
     // deterministic pseudo-noise, ±0.05 µm

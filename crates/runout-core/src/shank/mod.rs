@@ -13,6 +13,8 @@
 //! ```
 
 mod calibration;
+mod deconvolve;
+mod dynamics;
 mod filter;
 mod process;
 mod spindle;
@@ -21,6 +23,12 @@ mod synthetic;
 mod template;
 
 pub use calibration::{calibrate, LoadStep, StaticCalibration};
+pub use deconvolve::Deconvolver;
+pub use dynamics::{
+    bandwidth, default_density_kg_per_m3, regularised_inverse, usable_bandwidth_hz, Correction,
+    ShankBandwidth, ShankDynamics, BANDWIDTH_TOLERANCE, CARBIDE_DENSITY_KG_PER_M3,
+    CHECKED_TOOTH_HARMONICS, STEEL_DENSITY_KG_PER_M3,
+};
 pub use filter::{Biquad, Butterworth, ZeroPhaseStream};
 pub use process::{
     analyse, append, process_in_memory, ComparisonMetrics, DcLevel, ForceComparison, OutputBlock,
@@ -53,7 +61,8 @@ pub enum ShankError {
 
 impl ShankSetup {
     /// A setup with defaults: drift correction on, no low-pass, ≥ 5 and ≤ 50 template
-    /// revolutions, no sensor range, runout at the tool tip, automatic bins.
+    /// revolutions, no sensor range, runout at the tool tip, automatic bins; dynamics: steel or
+    /// carbide density by modulus, ζ = 0.03, teeth unknown, no correction.
     pub fn new(
         beam: ShankBeam,
         pairs: Vec<SensorPair>,
@@ -61,6 +70,7 @@ impl ShankSetup {
         nominal_rpm: f64,
     ) -> Self {
         Self {
+            dynamics: ShankDynamics::for_beam(&beam),
             stiffness_n_per_mm: beam.stiffness_n_per_mm(),
             beam,
             pairs,

@@ -11,7 +11,8 @@
 //! 3. [`Reconstructor`] (pass 2, streaming): δ = x − g(θ(t)) − dc(t), Δ = δ_II − δ_I,
 //!    F_workpiece = −sign·K_δ·Δ (force on the workpiece, conventions.md), optional zero-phase
 //!    low-pass, saturated samples flagged and their force set to NaN, optional comparison with a
-//!    reference dynamometer channel.
+//!    reference dynamometer channel; optional deconvolution of the force by the tool's bending
+//!    response ([`super::Deconvolver`], before the low-pass).
 //!
 //! Memory: O(max_template_revolutions × samples per revolution) plus one f32 pair per pair and
 //! revolution, independent of the record length otherwise.
@@ -19,6 +20,7 @@
 // Column-major data (`columns[c][k]`) reads clearest with index loops.
 #![allow(clippy::needless_range_loop)]
 
+use super::deconvolve::Deconvolver;
 use super::filter::{Butterworth, ZeroPhaseStream};
 use super::spindle::{frequency_from_air, PhaseSegment, PulseDetector, SpindlePhase};
 use super::template::{AngleTemplate, TemplateBuilder};
@@ -99,6 +101,8 @@ pub struct ShankSetup {
     pub cutting_height_mm: f64,
     /// Angle bins of the template (0 = half the samples per revolution, 16…2048).
     pub template_bins: usize,
+    /// Bending dynamics: density, beam damping, teeth, optional force correction (issue 11).
+    pub dynamics: super::ShankDynamics,
 }
 
 impl ShankSetup {
@@ -547,6 +551,8 @@ pub struct ShankAnalysis {
     pub stiffness_n_per_mm: f64,
     /// RMS of x − g − dc over the air cuts per channel (template quality), mm.
     pub air_residual_rms_mm: Vec<f64>,
+    /// First bending mode, usable bandwidth and tooth-passing check (issue 11 item 7).
+    pub bandwidth: super::ShankBandwidth,
 }
 
 /// Detect the air cuts from the block statistics (see the module docs).
@@ -844,7 +850,12 @@ pub fn analyse(survey: &SurveyResult) -> Result<ShankAnalysis, ShankError> {
             "{saturated_samples} displacement samples are saturated (clipped at the sensor's range); their force is not computed (NaN) and they are flagged in the output"
         ));
     }
+    let axes: Vec<PairAxis> = s.pairs.iter().map(|p| p.axis).collect();
+    let (bandwidth, band_warning) =
+        super::bandwidth(&s.beam, &s.dynamics, &axes, f_est, fs).map_err(ShankError::Param)?;
+    warnings.extend(band_warning);
     Ok(ShankAnalysis {
+        bandwidth,
         air_segments: segments,
         cut,
         air_revolutions_found: found,
@@ -1022,7 +1033,9 @@ pub struct Reconstructor {
     hint: usize,
     sat_pos: usize,
     filter: Option<ZeroPhaseStream>,
+    deconvolver: Option<Deconvolver>,
     pending: VecDeque<(u64, bool, Vec<f64>)>,
+    staged: Vec<Vec<f64>>,
     filtered: Vec<Vec<f64>>,
     comparisons: Vec<ForceComparison>,
 }
@@ -1095,6 +1108,19 @@ impl Reconstructor {
             )),
             None => None,
         };
+        // force columns (one per pair) deconvolved by the chain of their axis; δ columns delayed
+        let deconvolver = s.dynamics.correction.as_ref().map(|c| {
+            let np = s.pairs.len();
+            let cols: Vec<Option<&crate::chain::AxisChain>> = (0..3 * np)
+                .map(|i| {
+                    (i < np).then(|| match s.pairs[i].axis {
+                        PairAxis::X => &c.chain.x,
+                        PairAxis::Y => &c.chain.y,
+                    })
+                })
+                .collect();
+            Deconvolver::new(&cols, c.floor, s.sample_rate_hz)
+        });
         Ok(Self {
             setup: s.clone(),
             analysis: analysis.clone(),
@@ -1102,6 +1128,8 @@ impl Reconstructor {
             hint: 0,
             sat_pos: 0,
             filter,
+            deconvolver,
+            staged: vec![Vec::new(); 3 * s.pairs.len()],
             pending: VecDeque::new(),
             filtered: vec![Vec::new(); 3 * s.pairs.len()],
             comparisons: vec![ForceComparison::default(); s.pairs.len()],
@@ -1171,25 +1199,62 @@ impl Reconstructor {
                 Vec::new()
             };
             self.n += 1;
-            match &mut self.filter {
-                Some(f) => {
-                    self.pending.push_back((n, sat, refs));
-                    f.push(&row, &mut self.filtered);
-                    self.drain_filtered(out);
-                }
-                None => self.emit(n, sat, &row, &refs, out),
+            if self.filter.is_none() && self.deconvolver.is_none() {
+                self.emit(n, sat, &row, &refs, out);
+                continue;
             }
+            self.pending.push_back((n, sat, refs));
+            match &mut self.deconvolver {
+                Some(d) => d.push(&row, &mut self.staged),
+                None => {
+                    for (st, v) in self.staged.iter_mut().zip(&row) {
+                        st.push(*v);
+                    }
+                }
+            }
+            self.stage_to_filter(false);
+            self.drain_filtered(out);
         }
         Ok(())
     }
 
-    /// Flush at the end of the record (only needed with a low-pass).
+    /// Rows out of the deconvolution (if any) into the low-pass (if any).
+    fn stage_to_filter(&mut self, last: bool) {
+        let staged = std::mem::take(&mut self.staged);
+        match &mut self.filter {
+            Some(f) => {
+                let mut row = vec![0.0; staged.len()];
+                for i in 0..staged[0].len() {
+                    for (r, c) in row.iter_mut().zip(&staged) {
+                        *r = c[i];
+                    }
+                    f.push(&row, &mut self.filtered);
+                }
+                if last {
+                    f.finish(&mut self.filtered);
+                }
+            }
+            None => {
+                for (fc, sc) in self.filtered.iter_mut().zip(&staged) {
+                    fc.extend_from_slice(sc);
+                }
+            }
+        }
+        self.staged = staged;
+        self.staged.iter_mut().for_each(Vec::clear);
+    }
+
+    /// Flush at the end of the record (only needed with a low-pass or a correction).
     pub fn finish(&mut self, out: &mut OutputBlock) {
         out.clear(self.setup.pairs.len(), self.setup.has_reference);
-        if let Some(f) = &mut self.filter {
-            f.finish(&mut self.filtered);
-            self.drain_filtered(out);
+        if self.filter.is_none() && self.deconvolver.is_none() {
+            return;
         }
+        if let Some(d) = &mut self.deconvolver {
+            d.finish(&mut self.staged);
+        }
+        self.stage_to_filter(true);
+        self.drain_filtered(out);
     }
 
     fn drain_filtered(&mut self, out: &mut OutputBlock) {

@@ -1,9 +1,14 @@
 //! Synthetic shank-sensor recordings for tests, examples and benchmarks: the beam's deflection
 //! under a periodic cutting force plus the air-cut pattern (runout offset + tilt and shank form
 //! error rotating with the spindle), gap offsets, optional drift, spindle-speed error and sensor
-//! noise — the forward model that [`super::process_in_memory`] inverts.
+//! noise — the forward model that [`super::process_in_memory`] inverts. With a [`MeasuringChain`]
+//! the tool's bending response is included (issue 11 item 7): the deflections follow the force
+//! through H of the axis, integrated in the time domain by [`crate::chain::AxisChain::filter`]
+//! (exact for a force linear between samples), so that a recording through a mode tests the
+//! correction.
 
 use super::{PairAxis, ShankBeam};
+use crate::chain::MeasuringChain;
 use std::f64::consts::TAU;
 
 /// Parameters of a synthetic recording.
@@ -31,6 +36,9 @@ pub struct SyntheticShank {
     pub ramp_revolutions: f64,
     /// Add a once-per-revolution pulse channel (5 V for 5 % of a revolution from θ = 0).
     pub pulse: bool,
+    /// Bending response between the force and the deflections, per axis (x, y; z unused);
+    /// rigid by default.
+    pub chain: MeasuringChain,
 }
 
 /// A generated recording.
@@ -38,7 +46,7 @@ pub struct SyntheticShank {
 pub struct SyntheticRecording {
     /// Columns: per axis (x, y) sensor I and II displacement (mm), then the pulse if any.
     pub columns: Vec<Vec<f64>>,
-    /// True force on the workpiece per axis, N.
+    /// True force on the workpiece per axis, N (before the chain).
     pub force_n: [Vec<f64>; 2],
     /// First and one-past-last sample of the cut.
     pub cut: (usize, usize),
@@ -81,8 +89,7 @@ impl SyntheticShank {
             )
         };
         for k in 0..total {
-            let t = k as f64 / fs;
-            let th = TAU * f * t;
+            let th = TAU * f * k as f64 / fs;
             let rev = th / TAU;
             let env = if k < start || k >= end {
                 0.0
@@ -90,11 +97,18 @@ impl SyntheticShank {
                 let r_in = (rev - ra).min(ra + rc - rev);
                 (r_in / self.ramp_revolutions.max(1e-9)).clamp(0.0, 1.0)
             };
-            let (fxv, fyv) = (env * force_at(th, fx), env * force_at(th, fy));
-            tx.push(fxv);
-            ty.push(fyv);
-            for (axis, f_wp) in [(PairAxis::X, fxv), (PairAxis::Y, fyv)] {
+            tx.push(env * force_at(th, fx));
+            ty.push(env * force_at(th, fy));
+        }
+        // the force the deflections follow: through the bending response of each axis
+        let seen = [self.chain.x.filter(fs, &tx), self.chain.y.filter(fs, &ty)];
+        for k in 0..total {
+            let t = k as f64 / fs;
+            let th = TAU * f * t;
+            let rev = th / TAU;
+            for axis in [PairAxis::X, PairAxis::Y] {
                 let a = usize::from(axis == PairAxis::Y);
+                let f_wp = seen[a][k];
                 for (h, (z, c, gap)) in [(z1, c1, self.gap_mm.0), (z2, c2, self.gap_mm.1)]
                     .into_iter()
                     .enumerate()
