@@ -102,13 +102,13 @@ impl SyntheticShank {
         }
         // the force the deflections follow: through the bending response of each axis
         let seen = [self.chain.x.filter(fs, &tx), self.chain.y.filter(fs, &ty)];
-        for k in 0..total {
+        for (k, (&sx, &sy)) in seen[0].iter().zip(&seen[1]).enumerate() {
             let t = k as f64 / fs;
             let th = TAU * f * t;
             let rev = th / TAU;
             for axis in [PairAxis::X, PairAxis::Y] {
                 let a = usize::from(axis == PairAxis::Y);
-                let f_wp = seen[a][k];
+                let f_wp = if a == 0 { sx } else { sy };
                 for (h, (z, c, gap)) in [(z1, c1, self.gap_mm.0), (z2, c2, self.gap_mm.1)]
                     .into_iter()
                     .enumerate()
