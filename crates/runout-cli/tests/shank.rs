@@ -45,6 +45,15 @@ fn stiffness_reproduces_the_patent_examples() {
         "{j}"
     );
     assert_eq!(j["schema"], "runout.shank.stiffness/1");
+    // first bending mode, steel by default for 210 GPa: 1.8751²/2π·sqrt(EI/(ρA·L⁴)) = 1370 Hz,
+    // usable to ≈ 0.30·f₁
+    assert_eq!(j["density_kg_per_m3"], 7850.0);
+    let f1 = j["first_bending_mode_hz"].as_f64().unwrap();
+    assert!((f1 - 1370.0).abs() < 5.0, "{j}");
+    assert!(
+        (j["usable_bandwidth_hz"].as_f64().unwrap() / f1 - 0.30).abs() < 0.01,
+        "{j}"
+    );
     let j = stiffness_json(&[
         "--modulus-gpa",
         "610",

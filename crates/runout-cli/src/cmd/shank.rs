@@ -65,6 +65,10 @@ pub struct StiffnessArgs {
     /// Rotational stiffness of the tool holder k_θ (N·m/rad); default rigid.
     #[arg(long, allow_hyphen_values = true)]
     holder_stiffness_nm_per_rad: Option<String>,
+    /// Density of the tool (kg/m³) for its first bending mode; default 14500 (carbide) if
+    /// --modulus-gpa ≥ 400, else 7850 (steel).
+    #[arg(long, allow_hyphen_values = true)]
+    density_kg_per_m3: Option<String>,
     /// Write JSON here (`-` = stdout).
     #[arg(long)]
     json: Option<PathBuf>,
@@ -161,8 +165,28 @@ fn stiffness(a: StiffnessArgs) -> Result<()> {
         beam = beam.with_holder_stiffness(k * 1e3)?;
     }
     let k = beam.stiffness_n_per_um();
+    let density = match &a.density_kg_per_m3 {
+        Some(t) => t
+            .trim()
+            .parse::<f64>()
+            .map_err(|_| anyhow::anyhow!("--density-kg-per-m3: `{t}` is not a number (kg/m³)"))?,
+        None => runout_core::shank::default_density_kg_per_m3(beam.modulus_n_per_mm2 / 1e3),
+    };
+    let f1 = beam
+        .first_bending_mode_hz(density)
+        .context("--density-kg-per-m3")?;
+    let mode = runout_core::chain::SensorMode::new(f1, 0.03, 1.0)?;
+    let band = runout_core::shank::usable_bandwidth_hz(
+        &runout_core::chain::AxisChain::Modes(vec![mode]),
+        None,
+        10.0 * f1,
+    );
     let j = json!({
         "schema": "runout.shank.stiffness/1",
+        "first_bending_mode_hz": f1,
+        "density_kg_per_m3": density,
+        "usable_bandwidth_hz": band,
+        "bandwidth_criterion": "|H(f) - 1| <= 10 % for one mode at f1, damping 0.03 (docs/shank.md)",
         "stiffness_N_per_um": k,
         "stiffness_N_per_mm": beam.stiffness_n_per_mm(),
         "second_moment_mm4": beam.second_moment_mm4(),
@@ -185,6 +209,9 @@ fn stiffness(a: StiffnessArgs) -> Result<()> {
             "K_delta = {k:.6} N/um  (I = {:.2} mm^4, load at {} mm from the holder face)",
             beam.second_moment_mm4(),
             beam.load_distance_mm()
+        );
+        println!(
+            "first bending mode {f1:.0} Hz ({density} kg/m^3): static force usable to {band:.0} Hz (|H - 1| <= 10 %)"
         );
     }
     Ok(())

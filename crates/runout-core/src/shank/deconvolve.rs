@@ -284,7 +284,10 @@ mod tests {
         let err = (0..n)
             .map(|k| (stream[k] - whole[k] / len as f64).abs())
             .fold(0.0, f64::max);
-        assert!(err < 1e-4, "max difference {err} N on a 130 N signal (measured 6e-6)");
+        assert!(
+            err < 1e-4,
+            "max difference {err} N on a 130 N signal (measured 6e-6)"
+        );
         // the same mode as a measured FRF (5 Hz steps to 9 kHz): agrees to 0.05 N (linear
         // interpolation between 5 Hz steps across the 2ζf₁ = 54 Hz wide resonance, ≲ 0.2 % of H)
         let freq: Vec<f64> = (0..=1800).map(|i| i as f64 * 5.0).collect();
