@@ -64,11 +64,7 @@ impl SensorMode {
             ));
         }
         if !gain.is_finite() {
-            return Err(ParamError::new(
-                "sensor_gain",
-                "a finite relative gain",
-                gain,
-            ));
+            return Err(ParamError::new("sensor_gain", "a finite relative gain", gain));
         }
         Ok(SensorMode {
             frequency_hz,
@@ -342,12 +338,8 @@ mod tests {
         let f = 950.0;
         let (dfn, dz) = m.unit_response_derivatives(f);
         let h = 1e-4;
-        let num_fn = (SensorMode::new(1100.0 + h, 0.05, 1.0)
-            .unwrap()
-            .unit_response(f)
-            - SensorMode::new(1100.0 - h, 0.05, 1.0)
-                .unwrap()
-                .unit_response(f))
+        let num_fn = (SensorMode::new(1100.0 + h, 0.05, 1.0).unwrap().unit_response(f)
+            - SensorMode::new(1100.0 - h, 0.05, 1.0).unwrap().unit_response(f))
             / (2.0 * h);
         let num_z = (SensorMode::new(1100.0, 0.05 + 1e-7, 1.0)
             .unwrap()
@@ -375,11 +367,7 @@ mod tests {
         assert_eq!(c.at(0.0), Some(Complex64::new(1.0, 0.0)));
         assert_eq!(c.at(50.0), Some(Complex64::new(1.5, 0.5)));
         assert_eq!(c.at(200.1), None);
-        let err = FrfCurve::new(
-            "f.csv xx",
-            vec![0.0, 0.0],
-            vec![Complex64::new(1.0, 0.0); 2],
-        );
+        let err = FrfCurve::new("f.csv xx", vec![0.0, 0.0], vec![Complex64::new(1.0, 0.0); 2]);
         assert!(err.unwrap_err().to_string().contains("f.csv xx row 2"));
     }
 
