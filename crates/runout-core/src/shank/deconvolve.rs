@@ -9,7 +9,8 @@
 //! ±M samples, so the kept samples equal whole-record deconvolution to ~10⁻⁶ relative, while
 //! memory stays N samples per column — bounded for hour-long records, like the low-pass.
 //! The record is extended at both ends by its first/last value (G(0) = 1 passes a constant
-//! unchanged).
+//! unchanged). A non-finite sample is held at the previous value inside the transform and is NaN
+//! in the output.
 //!
 //! Why the time series and not the synchronous average: the output of `shank force` is the force
 //! history (entry, exit, tooth-to-tooth variation), not one averaged revolution, and H is linear
@@ -179,7 +180,17 @@ impl Deconvolver {
             match &self.gains[c] {
                 None => out[c].extend_from_slice(&b[m..m + keep]),
                 Some(g) => {
+                    // a non-finite sample is held at the previous finite value for the
+                    // transform and stays NaN in the output
                     let mut x = b.clone();
+                    let mut hold = x.iter().copied().find(|v| v.is_finite()).unwrap_or(0.0);
+                    for v in &mut x {
+                        if v.is_finite() {
+                            hold = *v;
+                        } else {
+                            *v = hold;
+                        }
+                    }
                     let mut spec = self.fwd.make_output_vec();
                     self.fwd.process(&mut x, &mut spec).expect("fft length");
                     for (s, gk) in spec.iter_mut().zip(g) {
@@ -187,7 +198,13 @@ impl Deconvolver {
                     }
                     let mut y = self.inv.make_output_vec();
                     self.inv.process(&mut spec, &mut y).expect("fft length");
-                    out[c].extend(y[m..m + keep].iter().map(|v| v / n as f64));
+                    out[c].extend(y[m..m + keep].iter().zip(&b[m..m + keep]).map(|(v, raw)| {
+                        if raw.is_finite() {
+                            v / n as f64
+                        } else {
+                            f64::NAN
+                        }
+                    }));
                 }
             }
             b.drain(..n - 2 * m);
@@ -230,6 +247,15 @@ mod tests {
         d.finish(&mut out);
         assert_eq!(out[0].len(), n);
         assert_eq!(out[1], x);
+        // a NaN input sample is NaN in the output and does not spread
+        let mut d2 = Deconvolver::new(&[Some(&chain)], 0.1, fs);
+        let mut o2 = vec![Vec::new()];
+        for (k, v) in y.iter().enumerate() {
+            d2.push(&[if k == 10_000 { f64::NAN } else { *v }], &mut o2);
+        }
+        d2.finish(&mut o2);
+        assert!(o2[0][10_000].is_nan());
+        assert_eq!(o2[0].iter().filter(|v| v.is_nan()).count(), 1);
         // away from the record ends (constant extension there is not a sinusoid)
         let m0 = d.margin() + 2000;
         let err = (m0..n - m0)

@@ -15,7 +15,8 @@
 //!    response ([`super::Deconvolver`], before the low-pass).
 //!
 //! Memory: O(max_template_revolutions × samples per revolution) plus one f32 pair per pair and
-//! revolution, independent of the record length otherwise.
+//! revolution, plus the low-pass and deconvolution blocks (a few thousand samples per column),
+//! independent of the record length otherwise.
 
 // Column-major data (`columns[c][k]`) reads clearest with index loops.
 #![allow(clippy::needless_range_loop)]
@@ -1036,6 +1037,7 @@ pub struct Reconstructor {
     deconvolver: Option<Deconvolver>,
     pending: VecDeque<(u64, bool, Vec<f64>)>,
     staged: Vec<Vec<f64>>,
+    scratch: Vec<f64>,
     filtered: Vec<Vec<f64>>,
     comparisons: Vec<ForceComparison>,
 }
@@ -1130,6 +1132,7 @@ impl Reconstructor {
             filter,
             deconvolver,
             staged: vec![Vec::new(); 3 * s.pairs.len()],
+            scratch: vec![0.0; 3 * s.pairs.len()],
             pending: VecDeque::new(),
             filtered: vec![Vec::new(); 3 * s.pairs.len()],
             comparisons: vec![ForceComparison::default(); s.pairs.len()],
@@ -1223,12 +1226,11 @@ impl Reconstructor {
         let staged = std::mem::take(&mut self.staged);
         match &mut self.filter {
             Some(f) => {
-                let mut row = vec![0.0; staged.len()];
                 for i in 0..staged[0].len() {
-                    for (r, c) in row.iter_mut().zip(&staged) {
+                    for (r, c) in self.scratch.iter_mut().zip(&staged) {
                         *r = c[i];
                     }
-                    f.push(&row, &mut self.filtered);
+                    f.push(&self.scratch, &mut self.filtered);
                 }
                 if last {
                     f.finish(&mut self.filtered);
