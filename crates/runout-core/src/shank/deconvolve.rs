@@ -18,7 +18,7 @@
 //! deconvolved; the deflection columns are delayed with them unchanged (they are what the sensors
 //! read).
 
-use super::dynamics::regularised_inverse;
+use super::dynamics::correction_gain;
 use crate::chain::{AxisChain, Complex64};
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use std::sync::Arc;
@@ -47,28 +47,11 @@ impl std::fmt::Debug for Deconvolver {
     }
 }
 
-/// G on the real-FFT grid of length n, with a raised-cosine taper over the top 10 % of a
-/// measured FRF's range (G = 0 above it) so that its impulse response stays short.
+/// G on the real-FFT grid of length n ([`correction_gain`]: regularised inverse, tapered to 0 at
+/// the top of a measured FRF).
 fn gains_on_grid(chain: &AxisChain, floor: f64, fs: f64, n: usize) -> Vec<Complex64> {
-    let top = match chain {
-        AxisChain::Frf(c) => Some(c.max_frequency_hz()),
-        _ => None,
-    };
     let mut g: Vec<Complex64> = (0..=n / 2)
-        .map(|k| {
-            let f = k as f64 * fs / n as f64;
-            let taper = top.map_or(1.0, |t| {
-                let a = 0.9 * t;
-                if f <= a {
-                    1.0
-                } else if f >= t {
-                    0.0
-                } else {
-                    0.5 * (1.0 + (std::f64::consts::PI * (f - a) / (t - a)).cos())
-                }
-            });
-            regularised_inverse(chain.response(f), floor) * taper
-        })
+        .map(|k| correction_gain(chain, floor, k as f64 * fs / n as f64))
         .collect();
     // DC and Nyquist bins of a real signal are real
     g[0].im = 0.0;

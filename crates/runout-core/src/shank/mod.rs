@@ -25,9 +25,9 @@ mod template;
 pub use calibration::{calibrate, LoadStep, StaticCalibration};
 pub use deconvolve::Deconvolver;
 pub use dynamics::{
-    bandwidth, default_density_kg_per_m3, regularised_inverse, usable_bandwidth_hz, Correction,
-    ShankBandwidth, ShankDynamics, BANDWIDTH_TOLERANCE, CARBIDE_DENSITY_KG_PER_M3,
-    CHECKED_TOOTH_HARMONICS, STEEL_DENSITY_KG_PER_M3,
+    bandwidth, correction_gain, default_density_kg_per_m3, regularised_inverse,
+    usable_bandwidth_hz, Correction, ShankBandwidth, ShankDynamics, BANDWIDTH_TOLERANCE,
+    CARBIDE_DENSITY_KG_PER_M3, CHECKED_TOOTH_HARMONICS, STEEL_DENSITY_KG_PER_M3,
 };
 pub use filter::{Biquad, Butterworth, ZeroPhaseStream};
 pub use process::{
