@@ -647,6 +647,20 @@ fn bending_mode_bandwidth_warning_and_correction() {
     for (a, b) in e_frf.iter().zip(&e_mode) {
         assert!((a - b).abs() < 0.002, "FRF {a} vs mode {b}");
     }
+    // "beam": the beam model's own first mode (1370 Hz); on this 900 Hz recording it is the
+    // wrong mode, so the force stays wrong (the correction is only as good as its H)
+    let by_beam = force_json(&rec, &cfg("beam.toml", "sensor_mode_hz = \"beam\"\n"), &[]);
+    let c = &by_beam["dynamics"]["correction"];
+    assert!(
+        c["source"].as_str().unwrap().contains("1370.")
+            && c["source"].as_str().unwrap().contains("beam model"),
+        "{c}"
+    );
+    assert!(
+        errors(&by_beam).iter().all(|&e| e > 0.05),
+        "{:?}",
+        errors(&by_beam)
+    );
     // text report names the mode and the band
     let out = runout()
         .args(["shank", "force"])
