@@ -808,3 +808,110 @@ fn bending_mode_round_trip_wrong_without_correction_right_with_it() {
         plain.2.warnings
     );
 }
+
+/// The bending resonance seen in the cut spectrum: a recording through a 900 Hz mode (ζ 0.03)
+/// with a broadband random force (3 N RMS, the chip-to-chip part of a real cutting force) shows
+/// it between the spindle lines; the fit to the peak's shape gives f and ζ; a rigid recording
+/// shows none; the checks warn without a correction and with a correction at the wrong frequency.
+#[test]
+fn resonance_seen_in_the_cut_spectrum() {
+    let cutter = Cutter::flat(8.0, 3, 30.0).unwrap();
+    let tool_runout = Runout::new(0.010, 0.5).unwrap();
+    let cut = Cut::new(RPM, 0.05, 2.0)
+        .unwrap()
+        .radial(2.0, MillingMode::Down, &cutter)
+        .unwrap();
+    let coefficients =
+        CuttingCoefficients::new([1889.2, 806.1, 291.0], [63.12, 113.7, -3.1]).unwrap();
+    let chip = ArcChip::new(&cutter, &tool_runout, 0.05).unwrap();
+    let series = ForceModel {
+        cutter,
+        runout: tool_runout,
+        cut,
+        coefficients,
+    }
+    .simulate(&chip, &Sampling::new(1.0, 0.2, 20).unwrap());
+    let run = |chain: chain::MeasuringChain, correction: Option<Correction>| {
+        let syn = SyntheticShank {
+            beam: example1(),
+            sample_rate_hz: FS,
+            rpm: RPM * 1.001,
+            revolutions: (10.0, 150.0, 10.0),
+            offset_mm: (0.008, -0.003),
+            tilt: (0.0001, 0.0),
+            form_mm: (0.001, 0.0005),
+            gap_mm: (0.5, 0.45),
+            drift_mm: 0.0002,
+            ramp_revolutions: 1.0,
+            pulse: false,
+            chain,
+        };
+        let mut rng = StdRng::seed_from_u64(3);
+        let noise = Normal::new(0.0, 5e-5).unwrap();
+        let rec = syn.generate_with_random_force(&series.fx, &series.fy, 3.0, || rng.sample(noise));
+        let mut s = setup(false);
+        s.dynamics.teeth = Some(3);
+        s.dynamics.correction = correction;
+        let cols: Vec<&[f64]> = rec.columns.iter().map(Vec::as_slice).collect();
+        process_in_memory(&s, &cols).unwrap().0
+    };
+    let an = run(mode_chain(900.0, 0.03), None);
+    let seen = an.spectral_resonance.expect("resonance seen");
+    // 150 revolutions of 400 samples: 3 frames of 16 384; f within 1 % (0.1 % grid, line
+    // masking), ζ within 0.01 (3 frames × 2 axes of a χ² spectrum)
+    assert!((seen.frequency_hz / 900.0 - 1.0).abs() < 0.01, "{seen:?}");
+    assert!((seen.damping.unwrap() - 0.03).abs() < 0.01, "{seen:?}");
+    assert!(seen.prominence > 100.0 && seen.frames == 3, "{seen:?}");
+    let w = an
+        .warnings
+        .iter()
+        .find(|w| w.contains("seen in the cut spectrum"))
+        .expect("warning");
+    assert!(
+        w.contains("sensor_mode_hz = 900") && w.contains("harmonics 2 (300 Hz)"),
+        "{w}"
+    );
+    // the static relation's band with the mode seen: ≈ 0.30·900 Hz
+    let (usable, _) = spectral_check(
+        &an.bandwidth,
+        &setup(false).dynamics,
+        &[PairAxis::X, PairAxis::Y],
+        &seen,
+        FS,
+    );
+    assert!((usable / 900.0 - 0.30).abs() < 0.01, "{usable}");
+    // a rigid tool: the broadband force is white, no resonance
+    let rigid = run(Default::default(), None);
+    assert!(
+        rigid.spectral_resonance.is_none(),
+        "{:?}",
+        rigid.spectral_resonance
+    );
+    // corrected by the right mode: no warning; by the beam's 1370 Hz mode: the mismatch is
+    // named (its |H| peaks at f_n·sqrt(1 − 2ζ²) = 1369 Hz)
+    let right = run(
+        mode_chain(900.0, 0.03),
+        Some(Correction {
+            chain: mode_chain(900.0, 0.03),
+            source: "900 Hz".into(),
+            floor: 0.1,
+        }),
+    );
+    assert!(right.warnings.is_empty(), "{:?}", right.warnings);
+    let wrong = run(
+        mode_chain(900.0, 0.03),
+        Some(Correction {
+            chain: mode_chain(1370.0, 0.03),
+            source: "beam mode".into(),
+            floor: 0.1,
+        }),
+    );
+    assert!(
+        wrong
+            .warnings
+            .iter()
+            .any(|w| w.contains("has its resonance at 1369 Hz")),
+        "{:?}",
+        wrong.warnings
+    );
+}

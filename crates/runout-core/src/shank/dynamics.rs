@@ -297,6 +297,101 @@ pub fn bandwidth(
     ))
 }
 
+/// Frequency of the largest |H| of a chain below `f_limit` (its resonance), Hz; `None` for a
+/// rigid chain. Scanned in steps of f_limit/20 000.
+pub fn chain_peak_hz(h: &AxisChain, f_limit: f64) -> Option<f64> {
+    if h.is_rigid() {
+        return None;
+    }
+    (1..=20_000)
+        .map(|i| i as f64 * f_limit / 20_000.0)
+        .filter_map(|f| h.response(f).map(|v| (f, v.norm())))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|p| p.0)
+}
+
+/// What a resonance seen in the cut spectrum ([`super::SpectralResonance`]) says about the
+/// set-up: the usable band of the static relation with that mode (fitted damping, else the beam
+/// damping) and a warning when tooth-passing harmonics lie above it without a correction, or when
+/// a correction's resonance is more than 5 % away from the one seen.
+pub fn spectral_check(
+    band: &ShankBandwidth,
+    dynamics: &ShankDynamics,
+    axes: &[super::PairAxis],
+    seen: &super::SpectralResonance,
+    fs: f64,
+) -> (f64, Option<String>) {
+    let zeta = seen.damping.unwrap_or(dynamics.beam_damping);
+    let usable = crate::chain::SensorMode::new(seen.frequency_hz, zeta, 1.0)
+        .map(|m| usable_bandwidth_hz(&AxisChain::Modes(vec![m]), None, fs / 2.0))
+        .unwrap_or(f64::NAN);
+    let f_r = seen.frequency_hz;
+    let seen_text = format!(
+        "a resonance at {f_r:.0} Hz (damping {}) is seen in the cut spectrum ({:.0}× above the broadband level; beam model {:.0} Hz)",
+        seen.damping.map_or("not fitted".to_string(), |z| format!("{z:.3}")),
+        seen.prominence,
+        band.beam_mode_hz
+    );
+    let warning = match &dynamics.correction {
+        None => {
+            let beyond: Vec<(usize, f64)> = band
+                .tooth_frequency_hz
+                .map(|ft| {
+                    (1..=CHECKED_TOOTH_HARMONICS)
+                        .map(|k| (k, k as f64 * ft))
+                        .filter(|&(_, f)| f > usable)
+                        .collect()
+                })
+                .unwrap_or_default();
+            (!beyond.is_empty() || (f_r / band.beam_mode_hz - 1.0).abs() > 0.2).then(|| {
+                let harmonics = if beyond.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "; tooth-passing harmonics {} lie above it",
+                        beyond
+                            .iter()
+                            .map(|(k, f)| format!("{k} ({f:.0} Hz)"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                };
+                format!(
+                    "{seen_text}: with it the static relation is usable to {usable:.0} Hz{harmonics}; \
+                     correct with [dynamics] sensor_mode_hz = {f_r:.0} (sensor_damping = {zeta:.3}) \
+                     or a measured FRF"
+                )
+            })
+        }
+        Some(c) => {
+            let fs2 = fs / 2.0;
+            let peaks: Vec<f64> = axes
+                .iter()
+                .filter_map(|a| {
+                    chain_peak_hz(
+                        match a {
+                            super::PairAxis::X => &c.chain.x,
+                            super::PairAxis::Y => &c.chain.y,
+                        },
+                        fs2,
+                    )
+                })
+                .collect();
+            peaks
+                .iter()
+                .find(|p| (f_r / **p - 1.0).abs() > 0.05)
+                .map(|p| {
+                    format!(
+                        "{seen_text}, but the correction ({}) has its resonance at {p:.0} Hz: \
+                         the corrected force is wrong near both; check the correction",
+                        c.source
+                    )
+                })
+        }
+    };
+    (usable, warning)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -17,6 +17,7 @@ mod deconvolve;
 mod dynamics;
 mod filter;
 mod process;
+mod resonance;
 mod spindle;
 mod stiffness;
 mod synthetic;
@@ -25,9 +26,10 @@ mod template;
 pub use calibration::{calibrate, LoadStep, StaticCalibration};
 pub use deconvolve::Deconvolver;
 pub use dynamics::{
-    bandwidth, correction_gain, default_density_kg_per_m3, regularised_inverse,
-    usable_bandwidth_hz, Correction, ShankBandwidth, ShankDynamics, BANDWIDTH_TOLERANCE,
-    CARBIDE_DENSITY_KG_PER_M3, CHECKED_TOOTH_HARMONICS, STEEL_DENSITY_KG_PER_M3,
+    bandwidth, chain_peak_hz, correction_gain, default_density_kg_per_m3, regularised_inverse,
+    spectral_check, usable_bandwidth_hz, Correction, ShankBandwidth, ShankDynamics,
+    BANDWIDTH_TOLERANCE, CARBIDE_DENSITY_KG_PER_M3, CHECKED_TOOTH_HARMONICS,
+    STEEL_DENSITY_KG_PER_M3,
 };
 pub use filter::{Biquad, Butterworth, ZeroPhaseStream};
 pub use process::{
@@ -35,6 +37,7 @@ pub use process::{
     PairAxis, Reconstructor, SampleRange, SensorPair, ShankAnalysis, ShankRunout, ShankSetup,
     Survey, SurveyResult,
 };
+pub use resonance::{ResonanceSpectrum, SpectralResonance};
 pub use spindle::{
     frequency_from_air, peak_frequency, phasor, PhaseSegment, PulseDetector, SpindlePhase,
 };

@@ -554,6 +554,9 @@ pub struct ShankAnalysis {
     pub air_residual_rms_mm: Vec<f64>,
     /// First bending mode, usable bandwidth and tooth-passing check (issue 11 item 7).
     pub bandwidth: super::ShankBandwidth,
+    /// Resonance seen in the cut spectrum (set after pass 2 by [`process_in_memory`], or from
+    /// [`Reconstructor::spectral_resonance`]).
+    pub spectral_resonance: Option<super::SpectralResonance>,
 }
 
 /// Detect the air cuts from the block statistics (see the module docs).
@@ -857,6 +860,7 @@ pub fn analyse(survey: &SurveyResult) -> Result<ShankAnalysis, ShankError> {
     warnings.extend(band_warning);
     Ok(ShankAnalysis {
         bandwidth,
+        spectral_resonance: None,
         air_segments: segments,
         cut,
         air_revolutions_found: found,
@@ -1035,6 +1039,7 @@ pub struct Reconstructor {
     sat_pos: usize,
     filter: Option<ZeroPhaseStream>,
     deconvolver: Option<Deconvolver>,
+    spectrum: Option<super::ResonanceSpectrum>,
     pending: VecDeque<(u64, bool, Vec<f64>)>,
     staged: Vec<Vec<f64>>,
     scratch: Vec<f64>,
@@ -1123,7 +1128,15 @@ impl Reconstructor {
                 .collect();
             Deconvolver::new(&cols, c.floor, s.sample_rate_hz)
         });
+        let spectrum = analysis.cut.map(|_| {
+            super::ResonanceSpectrum::new(
+                s.pairs.len(),
+                s.sample_rate_hz,
+                analysis.spindle.mean_frequency_hz(),
+            )
+        });
         Ok(Self {
+            spectrum,
             setup: s.clone(),
             analysis: analysis.clone(),
             n: 0,
@@ -1202,6 +1215,13 @@ impl Reconstructor {
                 Vec::new()
             };
             self.n += 1;
+            if let (Some(sp), Some(c)) = (&mut self.spectrum, self.analysis.cut) {
+                if n >= c.start && n < c.end && !sat {
+                    sp.push(&row[..np]);
+                } else {
+                    sp.break_frame();
+                }
+            }
             if self.filter.is_none() && self.deconvolver.is_none() {
                 self.emit(n, sat, &row, &refs, out);
                 continue;
@@ -1298,6 +1318,12 @@ impl Reconstructor {
         }
     }
 
+    /// The bending resonance seen in the spectrum of the (uncorrected) force over the cut, if one
+    /// stands out ([`super::ResonanceSpectrum`]).
+    pub fn spectral_resonance(&self) -> Option<super::SpectralResonance> {
+        self.spectrum.as_ref().and_then(|s| s.resonance())
+    }
+
     /// Validation metrics per pair over the cut (if reference channels were given).
     pub fn comparison(&self) -> Option<Vec<ComparisonMetrics>> {
         self.setup.has_reference.then(|| {
@@ -1310,7 +1336,8 @@ impl Reconstructor {
 }
 
 /// Convenience for small records held in memory: both passes over `columns`.
-/// Returns the analysis and the full output.
+/// Returns the analysis (with the resonance seen in the cut spectrum and its warning) and the
+/// full output.
 pub fn process_in_memory(
     setup: &ShankSetup,
     columns: &[&[f64]],
@@ -1318,7 +1345,7 @@ pub fn process_in_memory(
     let mut survey = Survey::new(setup)?;
     survey.push(columns)?;
     let result = survey.finish()?;
-    let analysis = analyse(&result)?;
+    let mut analysis = analyse(&result)?;
     let mut rec = Reconstructor::new(&result, &analysis)?;
     let mut all = OutputBlock::default();
     let mut part = OutputBlock::default();
@@ -1327,6 +1354,18 @@ pub fn process_in_memory(
     rec.finish(&mut part);
     append(&mut all, &part);
     let cmp = rec.comparison();
+    analysis.spectral_resonance = rec.spectral_resonance();
+    if let Some(seen) = &analysis.spectral_resonance {
+        let axes: Vec<PairAxis> = setup.pairs.iter().map(|p| p.axis).collect();
+        let (_, w) = super::spectral_check(
+            &analysis.bandwidth,
+            &setup.dynamics,
+            &axes,
+            seen,
+            setup.sample_rate_hz,
+        );
+        analysis.warnings.extend(w);
+    }
     Ok((analysis, all, cmp))
 }
 

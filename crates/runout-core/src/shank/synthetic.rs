@@ -59,8 +59,34 @@ impl SyntheticShank {
         &self,
         fx: &[f64],
         fy: &[f64],
+        noise: impl FnMut() -> f64,
+    ) -> SyntheticRecording {
+        self.generate_with_random_force(fx, fy, 0.0, noise)
+    }
+
+    /// As [`SyntheticShank::generate`], plus a random (white, Gaussian, per-sample independent,
+    /// reproducible) force of RMS `random_force_n` N on each axis during the cut, scaled by the
+    /// entry/exit ramp — the broadband part of a real cutting force that makes the bending
+    /// resonance visible in the cut spectrum. It is part of the true force.
+    pub fn generate_with_random_force(
+        &self,
+        fx: &[f64],
+        fy: &[f64],
+        random_force_n: f64,
         mut noise: impl FnMut() -> f64,
     ) -> SyntheticRecording {
+        // xorshift64 + Box–Muller, fixed seed
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        };
+        let mut gauss = move || {
+            let (u1, u2) = (uniform(), uniform());
+            (-2.0 * u1.ln()).sqrt() * (TAU * u2).cos()
+        };
         let per_rev = fx.len();
         let force_at = |th: f64, v: &[f64]| {
             let u = (th / TAU).rem_euclid(1.0) * per_rev as f64;
@@ -97,8 +123,13 @@ impl SyntheticShank {
                 let r_in = (rev - ra).min(ra + rc - rev);
                 (r_in / self.ramp_revolutions.max(1e-9)).clamp(0.0, 1.0)
             };
-            tx.push(env * force_at(th, fx));
-            ty.push(env * force_at(th, fy));
+            let (rx, ry) = if random_force_n > 0.0 && env > 0.0 {
+                (random_force_n * gauss(), random_force_n * gauss())
+            } else {
+                (0.0, 0.0)
+            };
+            tx.push(env * (force_at(th, fx) + rx));
+            ty.push(env * (force_at(th, fy) + ry));
         }
         // the force the deflections follow: through the bending response of each axis
         let seen = [self.chain.x.filter(fs, &tx), self.chain.y.filter(fs, &ty)];
