@@ -174,6 +174,17 @@ fn synthetic_through(
     after: f64,
     chain: runout_core::chain::MeasuringChain,
 ) -> (Vec<Vec<f64>>, (usize, usize)) {
+    synthetic_random(before, cut, after, chain, 0.0)
+}
+
+/// The same with a random broadband force of `random_n` N RMS per axis during the cut.
+fn synthetic_random(
+    before: f64,
+    cut: f64,
+    after: f64,
+    chain: runout_core::chain::MeasuringChain,
+    random_n: f64,
+) -> (Vec<Vec<f64>>, (usize, usize)) {
     let cutter = Cutter::flat(8.0, 3, 30.0).unwrap();
     let runout = Runout::new(0.010, 0.5).unwrap();
     let c = Cut::new(3000.0, 0.05, 2.0)
@@ -206,7 +217,7 @@ fn synthetic_through(
     };
     let mut k = 0u64;
     // deterministic pseudo-noise, ±0.05 µm
-    let rec = syn.generate(&series.fx, &series.fy, || {
+    let rec = syn.generate_with_random_force(&series.fx, &series.fy, random_n, || {
         k = k
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
@@ -711,4 +722,65 @@ fn bending_mode_bandwidth_warning_and_correction() {
     .unwrap();
     let e = bad("xonly.toml", "frf = \"xonly.csv\"\n");
     assert!(e.contains("no yy_re/yy_im columns"), "{e}");
+}
+
+/// The resonance seen in the cut spectrum, reported in JSON and text with its warning: 120
+/// revolutions through a 900 Hz mode with a 1 N RMS random force (2 frames of 16 384 samples).
+#[test]
+fn resonance_from_the_cut_spectrum_is_reported() {
+    use runout_core::chain::{AxisChain, MeasuringChain, SensorMode};
+    let dir = tempfile::tempdir().unwrap();
+    let axis = AxisChain::Modes(vec![SensorMode::new(900.0, 0.03, 1.0).unwrap()]);
+    let (cols, _) = synthetic_random(
+        10.0,
+        120.0,
+        10.0,
+        MeasuringChain {
+            x: axis.clone(),
+            y: axis,
+            z: AxisChain::Rigid,
+        },
+        1.0,
+    );
+    let rec = dir.path().join("rec.csv");
+    write_csv(&rec, &cols);
+    let cfg = config(dir.path(), "");
+    let j = force_json(&rec, &cfg, &[]);
+    let sr = &j["dynamics"]["spectral_resonance"];
+    assert!(
+        (sr["frequency_hz"].as_f64().unwrap() / 900.0 - 1.0).abs() < 0.01,
+        "{sr}"
+    );
+    assert!(
+        (sr["damping"].as_f64().unwrap() - 0.03).abs() < 0.01,
+        "{sr}"
+    );
+    assert!(
+        (sr["static_usable_bandwidth_hz"].as_f64().unwrap() / 900.0 - 0.30).abs() < 0.01,
+        "{sr}"
+    );
+    // no teeth given: the seen mode is > 20 % off the beam model's 1370 Hz, which is warned
+    let w: Vec<&str> = j["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    assert!(
+        w.iter()
+            .any(|w| w.contains("seen in the cut spectrum") && w.contains("sensor_mode_hz = 90")),
+        "{w:?}"
+    );
+    let out = runout()
+        .args(["shank", "force"])
+        .arg(&rec)
+        .arg("--config")
+        .arg(&cfg)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("resonance seen in the cut spectrum at 9"),
+        "{text}"
+    );
 }

@@ -860,13 +860,28 @@ fn force(a: ForceArgs) -> Result<()> {
         s.finish().context("writing the output")?;
     }
     let comparison = rec.comparison();
+    let mut analysis = analysis;
+    analysis.spectral_resonance = rec.spectral_resonance();
     warnings.extend(analysis.warnings.iter().cloned());
+    let axes: Vec<PairAxis> = r.setup.pairs.iter().map(|p| p.axis).collect();
+    let seen_usable = analysis.spectral_resonance.map(|seen| {
+        let (usable, w) = runout_core::shank::spectral_check(
+            &analysis.bandwidth,
+            &r.setup.dynamics,
+            &axes,
+            &seen,
+            r.setup.sample_rate_hz,
+        );
+        warnings.extend(w);
+        usable
+    });
     let summary = summary_json(
         &a,
         &r,
         &info,
         samples,
         &analysis,
+        seen_usable,
         &stats,
         comparison.as_deref(),
         &plan,
@@ -1026,6 +1041,7 @@ fn summary_json(
     info: &RecordingInfo,
     samples: u64,
     an: &ShankAnalysis,
+    seen_usable_hz: Option<f64>,
     stats: &[Stats],
     cmp: Option<&[runout_core::shank::ComparisonMetrics]>,
     plan: &Plan,
@@ -1111,7 +1127,7 @@ fn summary_json(
                 "correlation": c.correlation,
             })).collect::<Vec<_>>(),
         })),
-        "dynamics": dynamics_json(r, an),
+        "dynamics": dynamics_json(r, an, seen_usable_hz),
         "saturated_samples": an.saturated_samples,
         "lowpass_hz": s.lowpass.map(|l| l.1),
         "output": a.out.as_ref().map(|p| json!({"path": p.display().to_string(), "columns": columns})),
@@ -1120,7 +1136,11 @@ fn summary_json(
 }
 
 /// The bending mode, usable bandwidth and correction (issue 11 item 7).
-fn dynamics_json(r: &Resolved, an: &ShankAnalysis) -> serde_json::Value {
+fn dynamics_json(
+    r: &Resolved,
+    an: &ShankAnalysis,
+    seen_usable_hz: Option<f64>,
+) -> serde_json::Value {
     let b = &an.bandwidth;
     let c = r.setup.dynamics.correction.as_ref();
     json!({
@@ -1141,6 +1161,14 @@ fn dynamics_json(r: &Resolved, an: &ShankAnalysis) -> serde_json::Value {
         "teeth": r.setup.dynamics.teeth,
         "tooth_frequency_hz": b.tooth_frequency_hz,
         "tooth_harmonics_beyond_band": b.harmonics_beyond.iter().map(|(k, f)| json!({"harmonic": k, "frequency_hz": f})).collect::<Vec<_>>(),
+        "spectral_resonance": an.spectral_resonance.map(|s| json!({
+            "frequency_hz": s.frequency_hz,
+            "damping": s.damping,
+            "prominence": s.prominence,
+            "frames": s.frames,
+            "static_usable_bandwidth_hz": seen_usable_hz,
+            "method": "Welch spectrum of the uncorrected force over the cut between the spindle lines; f and damping fitted to the peak (docs/shank.md)",
+        })),
     })
 }
 
@@ -1204,6 +1232,14 @@ fn print_summary(j: &serde_json::Value) {
             "                 corrected by {}: usable to {:.0} Hz",
             c["source"].as_str().unwrap_or(""),
             f(&d["corrected_bandwidth_hz"])
+        );
+    }
+    if let Some(sr) = d["spectral_resonance"].as_object() {
+        println!(
+            "                 resonance seen in the cut spectrum at {:.0} Hz (damping {}): static relation usable to {:.0} Hz",
+            f(&sr["frequency_hz"]),
+            sr["damping"].as_f64().map_or("not fitted".into(), |z| format!("{z:.3}")),
+            f(&sr["static_usable_bandwidth_hz"])
         );
     }
     if let Some(ft) = d["tooth_frequency_hz"].as_f64() {
