@@ -168,7 +168,7 @@ impl ResonanceSpectrum {
             .enumerate()
             .max_by(|a, b| a.1.total_cmp(b.1))?;
         let prominence = peak / base.max(f64::MIN_POSITIVE);
-        if !(prominence >= MIN_PROMINENCE) || i == 0 || i + 1 == levels.len() {
+        if prominence.is_nan() || prominence < MIN_PROMINENCE || i == 0 || i + 1 == levels.len() {
             return None;
         }
         let l = |k: usize| levels[k].max(f64::MIN_POSITIVE).ln();
