@@ -2,10 +2,13 @@
 //! `runout shank force`: 4 displacement channels (µm) at 100 kHz by default, plus the true force
 //! as reference channels.
 //!
-//! `cargo run --release -p runout-cli --example shank_recording -- OUT.csv [CUT_REVOLUTIONS] [RATE_HZ]`
+//! `cargo run --release -p runout-cli --example shank_recording -- OUT.csv [CUT_REVOLUTIONS] [RATE_HZ] [MODE_HZ]`
 //! (then `runout shank force OUT.csv --config crates/runout-cli/tests/data/shank.toml`).
+//! `MODE_HZ` puts a bending mode (Hz, damping 0.03) between force and deflections on both axes,
+//! `beam` the beam model's own first mode (steel, 1370 Hz for this tool); default rigid.
 
-use runout_core::shank::{ShankBeam, SyntheticShank};
+use runout_core::chain::{AxisChain, MeasuringChain, SensorMode};
+use runout_core::shank::{ShankBeam, SyntheticShank, STEEL_DENSITY_KG_PER_M3};
 use runout_core::*;
 use std::io::Write;
 
@@ -13,9 +16,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let out = args
         .get(1)
-        .ok_or("usage: shank_recording OUT.csv [CUT_REVOLUTIONS] [RATE_HZ]")?;
+        .ok_or("usage: shank_recording OUT.csv [CUT_REVOLUTIONS] [RATE_HZ] [MODE_HZ|beam]")?;
     let cut: f64 = args.get(2).map_or(Ok(300.0), |s| s.parse())?;
     let rate: f64 = args.get(3).map_or(Ok(100_000.0), |s| s.parse())?;
+    let beam = ShankBeam::new(210.0, 8.0, 65.0, 10.0, 30.0)?;
+    let chain = match args.get(4).map(String::as_str) {
+        None => MeasuringChain::default(),
+        Some(m) => {
+            let hz = if m == "beam" {
+                beam.first_bending_mode_hz(STEEL_DENSITY_KG_PER_M3)?
+            } else {
+                m.parse()?
+            };
+            let axis = AxisChain::Modes(vec![SensorMode::new(hz, 0.03, 1.0)?]);
+            MeasuringChain {
+                x: axis.clone(),
+                y: axis,
+                z: AxisChain::Rigid,
+            }
+        }
+    };
     let cutter = Cutter::flat(8.0, 3, 30.0)?;
     let runout = Runout::new(0.010, 30f64.to_radians())?;
     let c = Cut::new(3000.0, 0.05, 2.0)?.radial(2.0, MillingMode::Down, &cutter)?;
@@ -29,7 +49,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let series = model.simulate(&chip, &Sampling::new(1.0, 0.2, 20)?);
     let syn = SyntheticShank {
-        beam: ShankBeam::new(210.0, 8.0, 65.0, 10.0, 30.0)?,
+        beam,
         sample_rate_hz: rate,
         rpm: 3000.0 * 1.001,
         revolutions: (20.0, cut, 20.0),
@@ -40,6 +60,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         drift_mm: 0.0005,
         ramp_revolutions: 2.0,
         pulse: false,
+        chain,
     };
     // xorshift + Box–Muller: 0.05 µm Gaussian sensor noise, reproducible
     let mut state = 0x9E37_79B9_7F4A_7C15u64;

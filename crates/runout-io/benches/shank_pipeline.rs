@@ -46,6 +46,7 @@ fn generate() -> Vec<u8> {
         drift_mm: 0.0003,
         ramp_revolutions: 2.0,
         pulse: false,
+        chain: Default::default(),
     };
     let mut k = 1u64;
     let rec = syn.generate(&fx, &fy, || {

@@ -86,3 +86,106 @@ fn unknown_extension_is_an_error() {
     .unwrap_err();
     assert!(matches!(e, PlotError::Extension { .. }), "{e}");
 }
+
+/// Issue 11 acceptance: each predicted component is drawn in its legend colour (measured solid
+/// in the palette colour, predicted dashed in a darker shade of the same hue), not in black.
+/// (Fails on the former code: its predicted traces were three more black 360-point polylines
+/// and their legend samples were the measured colours.)
+#[test]
+fn waveform_predicted_traces_use_their_legend_colours() {
+    use runout_io::plot::colour;
+    use runout_io::plot::identify::predicted_colour;
+    let d = out_dir();
+    let x: Vec<f64> = (0..360).map(|i| i as f64).collect();
+    let wave = |k: f64, s: f64| -> Vec<f64> {
+        x.iter()
+            .map(|a| s * 100.0 * (a.to_radians() * k).sin())
+            .collect()
+    };
+    let (mx, my, mz) = (wave(2.0, 1.0), wave(2.0, -0.6), wave(4.0, 0.3));
+    let (px, py, pz) = (wave(2.0, 0.97), wave(2.0, -0.58), wave(4.0, 0.31));
+    let labels = ["F_x (N)", "F_y (N)", "F_z (N)"];
+    let measured: Vec<Curve> = labels
+        .iter()
+        .zip([&mx, &my, &mz])
+        .map(|(l, v)| Curve {
+            label: l,
+            values: v,
+        })
+        .collect();
+    let predicted: Vec<Curve> = labels
+        .iter()
+        .zip([&px, &py, &pz])
+        .map(|(l, v)| Curve {
+            label: l,
+            values: v,
+        })
+        .collect();
+    let f = d.join("overlay_colours.svg");
+    waveform_overlay(&f, &x, &measured, &predicted, "colours").unwrap();
+    let svg = std::fs::read_to_string(&f).unwrap();
+    let hex = |c: plotters::style::RGBColor| format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2);
+    // every polyline's stroke colour and point count, in drawing order
+    let lines: Vec<(String, usize)> = svg
+        .split("<polyline")
+        .skip(1)
+        .map(|el| {
+            let el = &el[..el.find("/>").unwrap()];
+            let stroke = el.split("stroke=\"").nth(1).unwrap();
+            let points = el.split("points=\"").nth(1).unwrap();
+            let points = &points[..points.find('"').unwrap()];
+            (
+                stroke[..7].to_uppercase(),
+                points.split_whitespace().count(),
+            )
+        })
+        .collect();
+    // the legend is drawn last: one 2-point sample per series, measured then predicted
+    let n = labels.len();
+    let legend: Vec<&str> = lines[lines.len() - 2 * n..]
+        .iter()
+        .map(|(c, _)| c.as_str())
+        .collect();
+    for i in 0..n {
+        assert_eq!(legend[i], hex(colour(i)), "legend of measured {i}");
+        assert_eq!(
+            legend[n + i],
+            hex(predicted_colour(i)),
+            "legend of predicted {i}"
+        );
+        assert_ne!(
+            legend[n + i],
+            legend[i],
+            "predicted {i} told apart from measured"
+        );
+        // same hue: each channel scaled by the same factor (0.6, rounded to a unit)
+        let (c, p) = (colour(i), predicted_colour(i));
+        for (a, b) in [(c.0, p.0), (c.1, p.1), (c.2, p.2)] {
+            assert!(
+                (f64::from(a) * 0.6 - f64::from(b)).abs() <= 0.5,
+                "{c:?} {p:?}"
+            );
+        }
+    }
+    // the traces: the measured ones are one polyline each (360 points), in their legend colour;
+    // then the predicted dashes, each in one predicted legend colour, all three present
+    let traces = &lines[..lines.len() - 2 * n];
+    let long: Vec<&(String, usize)> = traces.iter().filter(|(_, k)| *k >= 300).collect();
+    assert_eq!(long.len(), n, "{long:?}");
+    for (i, (c, _)) in long.iter().enumerate() {
+        assert_eq!(c, &hex(colour(i)));
+    }
+    let last_measured = traces.iter().rposition(|(_, k)| *k >= 300).unwrap();
+    let dashes = &traces[last_measured + 1..];
+    assert!(dashes.len() > 3 * n, "{} dashes", dashes.len());
+    for (i, want) in (0..n).map(|i| (i, hex(predicted_colour(i)))) {
+        let count = dashes.iter().filter(|(c, _)| *c == want).count();
+        assert!(count > 3, "predicted {i}: {count} dashes in {want}");
+    }
+    assert!(
+        dashes
+            .iter()
+            .all(|(c, _)| (0..n).any(|i| *c == hex(predicted_colour(i)))),
+        "a predicted dash in another colour: {dashes:?}"
+    );
+}

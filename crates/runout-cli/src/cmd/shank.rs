@@ -65,6 +65,10 @@ pub struct StiffnessArgs {
     /// Rotational stiffness of the tool holder k_θ (N·m/rad); default rigid.
     #[arg(long, allow_hyphen_values = true)]
     holder_stiffness_nm_per_rad: Option<String>,
+    /// Density of the tool (kg/m³) for its first bending mode; default 14500 (carbide) if
+    /// --modulus-gpa ≥ 400, else 7850 (steel).
+    #[arg(long, allow_hyphen_values = true)]
+    density_kg_per_m3: Option<String>,
     /// Write JSON here (`-` = stdout).
     #[arg(long)]
     json: Option<PathBuf>,
@@ -161,8 +165,28 @@ fn stiffness(a: StiffnessArgs) -> Result<()> {
         beam = beam.with_holder_stiffness(k * 1e3)?;
     }
     let k = beam.stiffness_n_per_um();
+    let density = match &a.density_kg_per_m3 {
+        Some(t) => t
+            .trim()
+            .parse::<f64>()
+            .map_err(|_| anyhow::anyhow!("--density-kg-per-m3: `{t}` is not a number (kg/m³)"))?,
+        None => runout_core::shank::default_density_kg_per_m3(beam.modulus_n_per_mm2 / 1e3),
+    };
+    let f1 = beam
+        .first_bending_mode_hz(density)
+        .context("--density-kg-per-m3")?;
+    let mode = runout_core::chain::SensorMode::new(f1, 0.03, 1.0)?;
+    let band = runout_core::shank::usable_bandwidth_hz(
+        &runout_core::chain::AxisChain::Modes(vec![mode]),
+        None,
+        10.0 * f1,
+    );
     let j = json!({
         "schema": "runout.shank.stiffness/1",
+        "first_bending_mode_hz": f1,
+        "density_kg_per_m3": density,
+        "usable_bandwidth_hz": band,
+        "bandwidth_criterion": "|H(f) - 1| <= 10 % for one mode at f1, damping 0.03 (docs/shank.md)",
         "stiffness_N_per_um": k,
         "stiffness_N_per_mm": beam.stiffness_n_per_mm(),
         "second_moment_mm4": beam.second_moment_mm4(),
@@ -186,6 +210,9 @@ fn stiffness(a: StiffnessArgs) -> Result<()> {
             beam.second_moment_mm4(),
             beam.load_distance_mm()
         );
+        println!(
+            "first bending mode {f1:.0} Hz ({density} kg/m^3): static force usable to {band:.0} Hz (|H - 1| <= 10 %)"
+        );
     }
     Ok(())
 }
@@ -193,6 +220,7 @@ fn stiffness(a: StiffnessArgs) -> Result<()> {
 /// Everything resolved from shank.toml.
 struct Resolved {
     setup: ShankSetup,
+    density_source: String,
     cfg: ShankConfig,
     stiffness_source: String,
     sensor_unit: Option<String>,
@@ -327,6 +355,7 @@ fn load_config(path: &Path, rate_flag: Option<&str>) -> Result<Resolved> {
         setup.max_template_revolutions = m.max(setup.min_air_revolutions);
     }
     setup.cutting_height_mm = ap.map_or(0.0, |a| a / 2.0);
+    let density_source = resolve_dynamics(&file, path, &cfg, &mut setup)?;
     let sensitivity = cfg
         .recording
         .sensitivity_um_per_v
@@ -341,6 +370,7 @@ fn load_config(path: &Path, rate_flag: Option<&str>) -> Result<Resolved> {
         })
         .transpose()?;
     Ok(Resolved {
+        density_source,
         sensor_unit: cfg.recording.sensor_unit.clone(),
         sensitivity_um_per_v: sensitivity,
         sample_rate_hz: rate,
@@ -348,6 +378,117 @@ fn load_config(path: &Path, rate_flag: Option<&str>) -> Result<Resolved> {
         cfg,
         stiffness_source: source,
     })
+}
+
+/// `[shank] density_kg_per_m3, teeth` and `[dynamics]` into `setup.dynamics`; returns where the
+/// density comes from.
+fn resolve_dynamics(
+    file: &str,
+    path: &Path,
+    cfg: &ShankConfig,
+    setup: &mut ShankSetup,
+) -> Result<String> {
+    let b = &cfg.shank;
+    let d = &cfg.dynamics;
+    let fraction = |key: &str, v: Option<f64>, default: f64| -> Result<f64> {
+        let x = v.unwrap_or(default);
+        if !(x.is_finite() && x > 0.0 && x < 1.0) {
+            bail!("{file}: [dynamics] {key} = {x}: expected a damping ratio between 0 and 1 (dimensionless)");
+        }
+        Ok(x)
+    };
+    let dy = &mut setup.dynamics;
+    let modulus_gpa = setup.beam.modulus_n_per_mm2 / 1e3;
+    let source = match &b.density_kg_per_m3 {
+        Some(v) => {
+            let rho = number(file, "density_kg_per_m3", v, Quantity::Dimensionless)?;
+            if !(rho.is_finite() && rho > 0.0) {
+                bail!("{file}: [shank] density_kg_per_m3 = {rho}: expected a density > 0 kg/m³");
+            }
+            dy.density_kg_per_m3 = rho;
+            "density_kg_per_m3 from the config".to_string()
+        }
+        None => format!(
+            "default for modulus_gpa = {modulus_gpa} ({}; carbide 14500 kg/m3 if modulus_gpa >= 400, else steel 7850 kg/m3)",
+            if modulus_gpa >= 400.0 { "carbide" } else { "steel" }
+        ),
+    };
+    if let Some(k) = b.teeth {
+        if k == 0 {
+            bail!("{file}: [shank] teeth = 0: expected the number of teeth of the cutter (≥ 1)");
+        }
+        dy.teeth = Some(k);
+    }
+    dy.beam_damping = fraction("beam_damping", d.beam_damping, 0.03)?;
+    let floor = d.deconvolution_floor.unwrap_or(0.1);
+    if !(floor.is_finite() && floor > 0.0 && floor <= 1.0) {
+        bail!("{file}: [dynamics] deconvolution_floor = {floor}: expected 0 < ε ≤ 1 (dimensionless, |H| where the correction fades out)");
+    }
+    let chain = match (&d.sensor_mode_hz, &d.frf) {
+        (Some(_), Some(_)) => {
+            bail!("{file}: [dynamics] give sensor_mode_hz or frf, not both")
+        }
+        (None, None) => {
+            if d.sensor_damping.is_some() {
+                bail!("{file}: [dynamics] sensor_damping needs sensor_mode_hz (Hz or \"beam\")");
+            }
+            None
+        }
+        (Some(v), None) => {
+            let zeta = fraction("sensor_damping", d.sensor_damping, 0.03)?;
+            let (hz, what) = match v {
+                runout_io::config::Value::Text(t) if t.trim() == "beam" => (
+                    setup
+                        .beam
+                        .first_bending_mode_hz(dy.density_kg_per_m3)
+                        .with_context(|| format!("{file}: [shank]"))?,
+                    "first bending mode of the beam model",
+                ),
+                v => (
+                    number(file, "sensor_mode_hz", v, Quantity::FrequencyHz).map_err(|e| {
+                        anyhow::anyhow!("{e} (or \"beam\" for the beam's own first mode)")
+                    })?,
+                    "sensor_mode_hz",
+                ),
+            };
+            let mode = runout_core::chain::SensorMode::new(hz, zeta, 1.0)
+                .with_context(|| format!("{file}: [dynamics]"))?;
+            let axis = runout_core::chain::AxisChain::Modes(vec![mode]);
+            Some((
+                runout_core::chain::MeasuringChain {
+                    x: axis.clone(),
+                    y: axis,
+                    z: runout_core::chain::AxisChain::Rigid,
+                },
+                format!("one mode at {hz:.1} Hz, damping {zeta} ({what})"),
+            ))
+        }
+        (None, Some(f)) => {
+            let p = path.parent().unwrap_or(Path::new(".")).join(f);
+            let chain = runout_io::frf::read_frf(&p)?;
+            for pair in &setup.pairs {
+                let h = if pair.axis == PairAxis::X {
+                    &chain.x
+                } else {
+                    &chain.y
+                };
+                if h.is_rigid() {
+                    let a = pair.axis.letter();
+                    bail!(
+                        "{}: no {a}{a}_re/{a}{a}_im columns for the [[pair]] on axis {a} ({file}: [dynamics] frf)",
+                        p.display()
+                    );
+                }
+            }
+            Some((chain, format!("measured FRF {}", p.display())))
+        }
+    };
+    dy.correction = chain.map(|(chain, source)| runout_core::shank::Correction {
+        chain,
+        source,
+        floor,
+    });
+    Ok(source)
 }
 
 /// Scale from a displacement channel's unit to mm.
@@ -719,13 +860,28 @@ fn force(a: ForceArgs) -> Result<()> {
         s.finish().context("writing the output")?;
     }
     let comparison = rec.comparison();
+    let mut analysis = analysis;
+    analysis.spectral_resonance = rec.spectral_resonance();
     warnings.extend(analysis.warnings.iter().cloned());
+    let axes: Vec<PairAxis> = r.setup.pairs.iter().map(|p| p.axis).collect();
+    let seen_usable = analysis.spectral_resonance.map(|seen| {
+        let (usable, w) = runout_core::shank::spectral_check(
+            &analysis.bandwidth,
+            &r.setup.dynamics,
+            &axes,
+            &seen,
+            r.setup.sample_rate_hz,
+        );
+        warnings.extend(w);
+        usable
+    });
     let summary = summary_json(
         &a,
         &r,
         &info,
         samples,
         &analysis,
+        seen_usable,
         &stats,
         comparison.as_deref(),
         &plan,
@@ -885,6 +1041,7 @@ fn summary_json(
     info: &RecordingInfo,
     samples: u64,
     an: &ShankAnalysis,
+    seen_usable_hz: Option<f64>,
     stats: &[Stats],
     cmp: Option<&[runout_core::shank::ComparisonMetrics]>,
     plan: &Plan,
@@ -970,10 +1127,48 @@ fn summary_json(
                 "correlation": c.correlation,
             })).collect::<Vec<_>>(),
         })),
+        "dynamics": dynamics_json(r, an, seen_usable_hz),
         "saturated_samples": an.saturated_samples,
         "lowpass_hz": s.lowpass.map(|l| l.1),
         "output": a.out.as_ref().map(|p| json!({"path": p.display().to_string(), "columns": columns})),
         "warnings": warnings,
+    })
+}
+
+/// The bending mode, usable bandwidth and correction (issue 11 item 7).
+fn dynamics_json(
+    r: &Resolved,
+    an: &ShankAnalysis,
+    seen_usable_hz: Option<f64>,
+) -> serde_json::Value {
+    let b = &an.bandwidth;
+    let c = r.setup.dynamics.correction.as_ref();
+    json!({
+        "first_bending_mode_hz": b.beam_mode_hz,
+        "first_bending_mode_source": "Euler-Bernoulli cantilever from the [shank] beam: f1 = (beta1 L)^2/(2 pi) sqrt(E I/(rho A L^4)), beta1 L = 1.8751 clamped (holder spring lowers it)",
+        "beam_damping": b.beam_damping,
+        "density_kg_per_m3": b.density_kg_per_m3,
+        "density_source": r.density_source,
+        "bandwidth_criterion": "lowest frequency where the reconstructed force harmonic is off by more than 10 %: |G(f) H(f) - 1| > 0.1 (G = 1 without correction)",
+        "uncorrected_bandwidth_hz": b.uncorrected_hz,
+        "corrected_bandwidth_hz": b.corrected_hz,
+        "usable_bandwidth_hz": b.usable_hz(),
+        "correction": c.map(|c| json!({
+            "source": c.source,
+            "deconvolution_floor": c.floor,
+            "method": "overlap-save FFT blocks, G = (1/H) |H|^4/(|H|^4 + eps^4)",
+        })),
+        "teeth": r.setup.dynamics.teeth,
+        "tooth_frequency_hz": b.tooth_frequency_hz,
+        "tooth_harmonics_beyond_band": b.harmonics_beyond.iter().map(|(k, f)| json!({"harmonic": k, "frequency_hz": f})).collect::<Vec<_>>(),
+        "spectral_resonance": an.spectral_resonance.map(|s| json!({
+            "frequency_hz": s.frequency_hz,
+            "damping": s.damping,
+            "prominence": s.prominence,
+            "frames": s.frames,
+            "static_usable_bandwidth_hz": seen_usable_hz,
+            "method": "Welch spectrum of the uncorrected force over the cut between the spindle lines; f and damping fitted to the peak (docs/shank.md)",
+        })),
     })
 }
 
@@ -1021,6 +1216,36 @@ fn print_summary(j: &serde_json::Value) {
             f["rms_N"].as_f64().unwrap_or(f64::NAN),
             f["min_N"].as_f64().unwrap_or(f64::NAN),
             f["max_N"].as_f64().unwrap_or(f64::NAN)
+        );
+    }
+    let d = &j["dynamics"];
+    let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+    println!(
+        "bandwidth        first bending mode {:.0} Hz (beam model, {:.0} kg/m3, damping {}); static F = K*Delta usable to {:.0} Hz (|H - 1| <= 10 %)",
+        f(&d["first_bending_mode_hz"]),
+        f(&d["density_kg_per_m3"]),
+        d["beam_damping"],
+        f(&d["uncorrected_bandwidth_hz"]),
+    );
+    if let Some(c) = d["correction"].as_object() {
+        println!(
+            "                 corrected by {}: usable to {:.0} Hz",
+            c["source"].as_str().unwrap_or(""),
+            f(&d["corrected_bandwidth_hz"])
+        );
+    }
+    if let Some(sr) = d["spectral_resonance"].as_object() {
+        println!(
+            "                 resonance seen in the cut spectrum at {:.0} Hz (damping {}): static relation usable to {:.0} Hz",
+            f(&sr["frequency_hz"]),
+            sr["damping"].as_f64().map_or("not fitted".into(), |z| format!("{z:.3}")),
+            f(&sr["static_usable_bandwidth_hz"])
+        );
+    }
+    if let Some(ft) = d["tooth_frequency_hz"].as_f64() {
+        println!(
+            "                 tooth passing {ft:.1} Hz, harmonics 1-5 up to {:.0} Hz",
+            5.0 * ft
         );
     }
     for v in j["validation"]["per_axis"].as_array().into_iter().flatten() {

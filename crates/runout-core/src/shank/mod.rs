@@ -13,20 +13,31 @@
 //! ```
 
 mod calibration;
+mod deconvolve;
+mod dynamics;
 mod filter;
 mod process;
+mod resonance;
 mod spindle;
 mod stiffness;
 mod synthetic;
 mod template;
 
 pub use calibration::{calibrate, LoadStep, StaticCalibration};
+pub use deconvolve::Deconvolver;
+pub use dynamics::{
+    bandwidth, chain_peak_hz, correction_gain, default_density_kg_per_m3, regularised_inverse,
+    spectral_check, usable_bandwidth_hz, Correction, ShankBandwidth, ShankDynamics,
+    BANDWIDTH_TOLERANCE, CARBIDE_DENSITY_KG_PER_M3, CHECKED_TOOTH_HARMONICS,
+    STEEL_DENSITY_KG_PER_M3,
+};
 pub use filter::{Biquad, Butterworth, ZeroPhaseStream};
 pub use process::{
     analyse, append, process_in_memory, ComparisonMetrics, DcLevel, ForceComparison, OutputBlock,
     PairAxis, Reconstructor, SampleRange, SensorPair, ShankAnalysis, ShankRunout, ShankSetup,
     Survey, SurveyResult,
 };
+pub use resonance::{ResonanceSpectrum, SpectralResonance};
 pub use spindle::{
     frequency_from_air, peak_frequency, phasor, PhaseSegment, PulseDetector, SpindlePhase,
 };
@@ -53,7 +64,8 @@ pub enum ShankError {
 
 impl ShankSetup {
     /// A setup with defaults: drift correction on, no low-pass, ≥ 5 and ≤ 50 template
-    /// revolutions, no sensor range, runout at the tool tip, automatic bins.
+    /// revolutions, no sensor range, runout at the tool tip, automatic bins; dynamics: steel or
+    /// carbide density by modulus, ζ = 0.03, teeth unknown, no correction.
     pub fn new(
         beam: ShankBeam,
         pairs: Vec<SensorPair>,
@@ -61,6 +73,7 @@ impl ShankSetup {
         nominal_rpm: f64,
     ) -> Self {
         Self {
+            dynamics: ShankDynamics::for_beam(&beam),
             stiffness_n_per_mm: beam.stiffness_n_per_mm(),
             beam,
             pairs,

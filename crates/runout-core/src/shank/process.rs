@@ -11,14 +11,17 @@
 //! 3. [`Reconstructor`] (pass 2, streaming): δ = x − g(θ(t)) − dc(t), Δ = δ_II − δ_I,
 //!    F_workpiece = −sign·K_δ·Δ (force on the workpiece, conventions.md), optional zero-phase
 //!    low-pass, saturated samples flagged and their force set to NaN, optional comparison with a
-//!    reference dynamometer channel.
+//!    reference dynamometer channel; optional deconvolution of the force by the tool's bending
+//!    response ([`super::Deconvolver`], before the low-pass).
 //!
 //! Memory: O(max_template_revolutions × samples per revolution) plus one f32 pair per pair and
-//! revolution, independent of the record length otherwise.
+//! revolution, plus the low-pass and deconvolution blocks (a few thousand samples per column),
+//! independent of the record length otherwise.
 
 // Column-major data (`columns[c][k]`) reads clearest with index loops.
 #![allow(clippy::needless_range_loop)]
 
+use super::deconvolve::Deconvolver;
 use super::filter::{Butterworth, ZeroPhaseStream};
 use super::spindle::{frequency_from_air, PhaseSegment, PulseDetector, SpindlePhase};
 use super::template::{AngleTemplate, TemplateBuilder};
@@ -99,6 +102,8 @@ pub struct ShankSetup {
     pub cutting_height_mm: f64,
     /// Angle bins of the template (0 = half the samples per revolution, 16…2048).
     pub template_bins: usize,
+    /// Bending dynamics: density, beam damping, teeth, optional force correction (issue 11).
+    pub dynamics: super::ShankDynamics,
 }
 
 impl ShankSetup {
@@ -547,6 +552,11 @@ pub struct ShankAnalysis {
     pub stiffness_n_per_mm: f64,
     /// RMS of x − g − dc over the air cuts per channel (template quality), mm.
     pub air_residual_rms_mm: Vec<f64>,
+    /// First bending mode, usable bandwidth and tooth-passing check (issue 11 item 7).
+    pub bandwidth: super::ShankBandwidth,
+    /// Resonance seen in the cut spectrum (set after pass 2 by [`process_in_memory`], or from
+    /// [`Reconstructor::spectral_resonance`]).
+    pub spectral_resonance: Option<super::SpectralResonance>,
 }
 
 /// Detect the air cuts from the block statistics (see the module docs).
@@ -844,7 +854,13 @@ pub fn analyse(survey: &SurveyResult) -> Result<ShankAnalysis, ShankError> {
             "{saturated_samples} displacement samples are saturated (clipped at the sensor's range); their force is not computed (NaN) and they are flagged in the output"
         ));
     }
+    let axes: Vec<PairAxis> = s.pairs.iter().map(|p| p.axis).collect();
+    let (bandwidth, band_warning) =
+        super::bandwidth(&s.beam, &s.dynamics, &axes, f_est, fs).map_err(ShankError::Param)?;
+    warnings.extend(band_warning);
     Ok(ShankAnalysis {
+        bandwidth,
+        spectral_resonance: None,
         air_segments: segments,
         cut,
         air_revolutions_found: found,
@@ -1022,7 +1038,11 @@ pub struct Reconstructor {
     hint: usize,
     sat_pos: usize,
     filter: Option<ZeroPhaseStream>,
+    deconvolver: Option<Deconvolver>,
+    spectrum: Option<super::ResonanceSpectrum>,
     pending: VecDeque<(u64, bool, Vec<f64>)>,
+    staged: Vec<Vec<f64>>,
+    scratch: Vec<f64>,
     filtered: Vec<Vec<f64>>,
     comparisons: Vec<ForceComparison>,
 }
@@ -1095,13 +1115,37 @@ impl Reconstructor {
             )),
             None => None,
         };
+        // force columns (one per pair) deconvolved by the chain of their axis; δ columns delayed
+        let deconvolver = s.dynamics.correction.as_ref().map(|c| {
+            let np = s.pairs.len();
+            let cols: Vec<Option<&crate::chain::AxisChain>> = (0..3 * np)
+                .map(|i| {
+                    (i < np).then(|| match s.pairs[i].axis {
+                        PairAxis::X => &c.chain.x,
+                        PairAxis::Y => &c.chain.y,
+                    })
+                })
+                .collect();
+            Deconvolver::new(&cols, c.floor, s.sample_rate_hz)
+        });
+        let spectrum = analysis.cut.map(|_| {
+            super::ResonanceSpectrum::new(
+                s.pairs.len(),
+                s.sample_rate_hz,
+                analysis.spindle.mean_frequency_hz(),
+            )
+        });
         Ok(Self {
+            spectrum,
             setup: s.clone(),
             analysis: analysis.clone(),
             n: 0,
             hint: 0,
             sat_pos: 0,
             filter,
+            deconvolver,
+            staged: vec![Vec::new(); 3 * s.pairs.len()],
+            scratch: vec![0.0; 3 * s.pairs.len()],
             pending: VecDeque::new(),
             filtered: vec![Vec::new(); 3 * s.pairs.len()],
             comparisons: vec![ForceComparison::default(); s.pairs.len()],
@@ -1171,25 +1215,68 @@ impl Reconstructor {
                 Vec::new()
             };
             self.n += 1;
-            match &mut self.filter {
-                Some(f) => {
-                    self.pending.push_back((n, sat, refs));
-                    f.push(&row, &mut self.filtered);
-                    self.drain_filtered(out);
+            if let (Some(sp), Some(c)) = (&mut self.spectrum, self.analysis.cut) {
+                if n >= c.start && n < c.end && !sat {
+                    sp.push(&row[..np]);
+                } else {
+                    sp.break_frame();
                 }
-                None => self.emit(n, sat, &row, &refs, out),
             }
+            if self.filter.is_none() && self.deconvolver.is_none() {
+                self.emit(n, sat, &row, &refs, out);
+                continue;
+            }
+            self.pending.push_back((n, sat, refs));
+            match &mut self.deconvolver {
+                Some(d) => d.push(&row, &mut self.staged),
+                None => {
+                    for (st, v) in self.staged.iter_mut().zip(&row) {
+                        st.push(*v);
+                    }
+                }
+            }
+            self.stage_to_filter(false);
+            self.drain_filtered(out);
         }
         Ok(())
     }
 
-    /// Flush at the end of the record (only needed with a low-pass).
+    /// Rows out of the deconvolution (if any) into the low-pass (if any).
+    fn stage_to_filter(&mut self, last: bool) {
+        let staged = std::mem::take(&mut self.staged);
+        match &mut self.filter {
+            Some(f) => {
+                for i in 0..staged[0].len() {
+                    for (r, c) in self.scratch.iter_mut().zip(&staged) {
+                        *r = c[i];
+                    }
+                    f.push(&self.scratch, &mut self.filtered);
+                }
+                if last {
+                    f.finish(&mut self.filtered);
+                }
+            }
+            None => {
+                for (fc, sc) in self.filtered.iter_mut().zip(&staged) {
+                    fc.extend_from_slice(sc);
+                }
+            }
+        }
+        self.staged = staged;
+        self.staged.iter_mut().for_each(Vec::clear);
+    }
+
+    /// Flush at the end of the record (only needed with a low-pass or a correction).
     pub fn finish(&mut self, out: &mut OutputBlock) {
         out.clear(self.setup.pairs.len(), self.setup.has_reference);
-        if let Some(f) = &mut self.filter {
-            f.finish(&mut self.filtered);
-            self.drain_filtered(out);
+        if self.filter.is_none() && self.deconvolver.is_none() {
+            return;
         }
+        if let Some(d) = &mut self.deconvolver {
+            d.finish(&mut self.staged);
+        }
+        self.stage_to_filter(true);
+        self.drain_filtered(out);
     }
 
     fn drain_filtered(&mut self, out: &mut OutputBlock) {
@@ -1231,6 +1318,12 @@ impl Reconstructor {
         }
     }
 
+    /// The bending resonance seen in the spectrum of the (uncorrected) force over the cut, if one
+    /// stands out ([`super::ResonanceSpectrum`]).
+    pub fn spectral_resonance(&self) -> Option<super::SpectralResonance> {
+        self.spectrum.as_ref().and_then(|s| s.resonance())
+    }
+
     /// Validation metrics per pair over the cut (if reference channels were given).
     pub fn comparison(&self) -> Option<Vec<ComparisonMetrics>> {
         self.setup.has_reference.then(|| {
@@ -1243,7 +1336,8 @@ impl Reconstructor {
 }
 
 /// Convenience for small records held in memory: both passes over `columns`.
-/// Returns the analysis and the full output.
+/// Returns the analysis (with the resonance seen in the cut spectrum and its warning) and the
+/// full output.
 pub fn process_in_memory(
     setup: &ShankSetup,
     columns: &[&[f64]],
@@ -1251,7 +1345,7 @@ pub fn process_in_memory(
     let mut survey = Survey::new(setup)?;
     survey.push(columns)?;
     let result = survey.finish()?;
-    let analysis = analyse(&result)?;
+    let mut analysis = analyse(&result)?;
     let mut rec = Reconstructor::new(&result, &analysis)?;
     let mut all = OutputBlock::default();
     let mut part = OutputBlock::default();
@@ -1260,6 +1354,18 @@ pub fn process_in_memory(
     rec.finish(&mut part);
     append(&mut all, &part);
     let cmp = rec.comparison();
+    analysis.spectral_resonance = rec.spectral_resonance();
+    if let Some(seen) = &analysis.spectral_resonance {
+        let axes: Vec<PairAxis> = setup.pairs.iter().map(|p| p.axis).collect();
+        let (_, w) = super::spectral_check(
+            &analysis.bandwidth,
+            &setup.dynamics,
+            &axes,
+            seen,
+            setup.sample_rate_hz,
+        );
+        analysis.warnings.extend(w);
+    }
     Ok((analysis, all, cmp))
 }
 

@@ -1,9 +1,14 @@
 //! Synthetic shank-sensor recordings for tests, examples and benchmarks: the beam's deflection
 //! under a periodic cutting force plus the air-cut pattern (runout offset + tilt and shank form
 //! error rotating with the spindle), gap offsets, optional drift, spindle-speed error and sensor
-//! noise — the forward model that [`super::process_in_memory`] inverts.
+//! noise — the forward model that [`super::process_in_memory`] inverts. With a [`MeasuringChain`]
+//! the tool's bending response is included (issue 11 item 7): the deflections follow the force
+//! through H of the axis, integrated in the time domain by [`crate::chain::AxisChain::filter`]
+//! (exact for a force linear between samples), so that a recording through a mode tests the
+//! correction.
 
 use super::{PairAxis, ShankBeam};
+use crate::chain::MeasuringChain;
 use std::f64::consts::TAU;
 
 /// Parameters of a synthetic recording.
@@ -31,6 +36,9 @@ pub struct SyntheticShank {
     pub ramp_revolutions: f64,
     /// Add a once-per-revolution pulse channel (5 V for 5 % of a revolution from θ = 0).
     pub pulse: bool,
+    /// Bending response between the force and the deflections, per axis (x, y; z unused);
+    /// rigid by default.
+    pub chain: MeasuringChain,
 }
 
 /// A generated recording.
@@ -38,7 +46,7 @@ pub struct SyntheticShank {
 pub struct SyntheticRecording {
     /// Columns: per axis (x, y) sensor I and II displacement (mm), then the pulse if any.
     pub columns: Vec<Vec<f64>>,
-    /// True force on the workpiece per axis, N.
+    /// True force on the workpiece per axis, N (before the chain).
     pub force_n: [Vec<f64>; 2],
     /// First and one-past-last sample of the cut.
     pub cut: (usize, usize),
@@ -51,8 +59,34 @@ impl SyntheticShank {
         &self,
         fx: &[f64],
         fy: &[f64],
+        noise: impl FnMut() -> f64,
+    ) -> SyntheticRecording {
+        self.generate_with_random_force(fx, fy, 0.0, noise)
+    }
+
+    /// As [`SyntheticShank::generate`], plus a random (white, Gaussian, per-sample independent,
+    /// reproducible) force of RMS `random_force_n` N on each axis during the cut, scaled by the
+    /// entry/exit ramp — the broadband part of a real cutting force that makes the bending
+    /// resonance visible in the cut spectrum. It is part of the true force.
+    pub fn generate_with_random_force(
+        &self,
+        fx: &[f64],
+        fy: &[f64],
+        random_force_n: f64,
         mut noise: impl FnMut() -> f64,
     ) -> SyntheticRecording {
+        // xorshift64 + Box–Muller, fixed seed
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        };
+        let mut gauss = move || {
+            let (u1, u2) = (uniform(), uniform());
+            (-2.0 * u1.ln()).sqrt() * (TAU * u2).cos()
+        };
         let per_rev = fx.len();
         let force_at = |th: f64, v: &[f64]| {
             let u = (th / TAU).rem_euclid(1.0) * per_rev as f64;
@@ -81,8 +115,7 @@ impl SyntheticShank {
             )
         };
         for k in 0..total {
-            let t = k as f64 / fs;
-            let th = TAU * f * t;
+            let th = TAU * f * k as f64 / fs;
             let rev = th / TAU;
             let env = if k < start || k >= end {
                 0.0
@@ -90,11 +123,23 @@ impl SyntheticShank {
                 let r_in = (rev - ra).min(ra + rc - rev);
                 (r_in / self.ramp_revolutions.max(1e-9)).clamp(0.0, 1.0)
             };
-            let (fxv, fyv) = (env * force_at(th, fx), env * force_at(th, fy));
-            tx.push(fxv);
-            ty.push(fyv);
-            for (axis, f_wp) in [(PairAxis::X, fxv), (PairAxis::Y, fyv)] {
+            let (rx, ry) = if random_force_n > 0.0 && env > 0.0 {
+                (random_force_n * gauss(), random_force_n * gauss())
+            } else {
+                (0.0, 0.0)
+            };
+            tx.push(env * (force_at(th, fx) + rx));
+            ty.push(env * (force_at(th, fy) + ry));
+        }
+        // the force the deflections follow: through the bending response of each axis
+        let seen = [self.chain.x.filter(fs, &tx), self.chain.y.filter(fs, &ty)];
+        for (k, (&sx, &sy)) in seen[0].iter().zip(&seen[1]).enumerate() {
+            let t = k as f64 / fs;
+            let th = TAU * f * t;
+            let rev = th / TAU;
+            for axis in [PairAxis::X, PairAxis::Y] {
                 let a = usize::from(axis == PairAxis::Y);
+                let f_wp = if a == 0 { sx } else { sy };
                 for (h, (z, c, gap)) in [(z1, c1, self.gap_mm.0), (z2, c2, self.gap_mm.1)]
                     .into_iter()
                     .enumerate()

@@ -11,6 +11,9 @@
 //! axial_depth_mm = 2           # also sets the runout report height a_p/2 above the tip
 //! # holder_stiffness_Nm_per_rad = 2e4   # rotational stiffness of the holder (optional)
 //! # stiffness_N_per_um = 1.95           # measured K_δ (static calibration) overrides the beam
+//! # density_kg_per_m3 = 7850    # for the first bending mode; default 14 500 (carbide) if
+//! #                              # modulus_gpa ≥ 400, else 7 850 (steel)
+//! # teeth = 3                    # tooth-passing harmonics k·K·n/60 (k ≤ 5) checked against the band
 //!
 //! [spindle]
 //! rpm = 3000                   # nominal
@@ -34,6 +37,14 @@
 //! # lowpass_hz = 2000          # zero-phase Butterworth below the first bending mode
 //! # lowpass_order = 4
 //! # sensor_range_um = [-250, 250]         # samples at/after the limits are flagged
+//!
+//! [dynamics]                   # bending response of the tool (issue 11; docs/shank.md)
+//! # beam_damping = 0.03        # ζ of the beam's first mode (bandwidth estimate)
+//! # sensor_mode_hz = "beam"    # correct the force by one mode: Hz, or "beam" (its first mode)
+//! # sensor_damping = 0.03      # ζ of that mode
+//! # frf = "tool_frf.csv"       # or by a measured FRF (freq_Hz, xx_re, xx_im, yy_re, yy_im),
+//! #                            # path relative to this file
+//! # deconvolution_floor = 0.1  # ε of G = (1/H)·|H|⁴/(|H|⁴ + ε⁴) (dimensionless)
 //! ```
 
 use super::{ConfigError, Value};
@@ -56,6 +67,25 @@ pub struct ShankConfig {
     /// Processing options.
     #[serde(default)]
     pub processing: ProcessingSection,
+    /// Bending dynamics and force correction.
+    #[serde(default)]
+    pub dynamics: DynamicsSection,
+}
+
+/// `[dynamics]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsSection {
+    /// Damping ratio of the beam's first mode (dimensionless).
+    pub beam_damping: Option<f64>,
+    /// Mode to correct by (Hz, or `"beam"`).
+    pub sensor_mode_hz: Option<Value>,
+    /// Damping ratio of that mode (dimensionless).
+    pub sensor_damping: Option<f64>,
+    /// Measured FRF file (relative to the config file).
+    pub frf: Option<String>,
+    /// Floor ε of the regularised inverse (dimensionless).
+    pub deconvolution_floor: Option<f64>,
 }
 
 /// `[shank]`.
@@ -82,6 +112,10 @@ pub struct BeamSection {
     /// Measured K_δ (N/µm).
     #[serde(rename = "stiffness_N_per_um")]
     pub stiffness_n_per_um: Option<Value>,
+    /// Density of the tool (kg/m³).
+    pub density_kg_per_m3: Option<Value>,
+    /// Number of teeth of the cutter.
+    pub teeth: Option<usize>,
 }
 
 /// `[spindle]`.

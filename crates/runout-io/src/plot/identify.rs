@@ -16,8 +16,9 @@ pub struct Curve<'a> {
     pub values: &'a [f64],
 }
 
-/// Measured (solid) and predicted (dashed-looking thin) force waveforms over one revolution.
-/// `measured[i]` and `predicted[i]` share a colour.
+/// Measured and predicted force waveforms over one revolution. `measured[i]` is drawn solid in
+/// the palette colour [`colour`]`(i)`, `predicted[i]` dashed in [`predicted_colour`]`(i)` (a
+/// darker shade of the same hue), and each legend entry shows the colour of its trace.
 pub fn waveform_overlay(
     path: &Path,
     angle_deg: &[f64],
@@ -28,6 +29,15 @@ pub fn waveform_overlay(
     render_plot!(path, (1100, 620), |root: &DrawingArea<_, Shift>| {
         draw_overlay(root, angle_deg, measured, predicted, title)
     })
+}
+
+/// Colour of the predicted trace `i` of [`waveform_overlay`]: [`colour`]`(i)` with each channel
+/// scaled by 0.6 (same hue, darker), so that a predicted component is told apart from its
+/// measured one yet matched to it.
+pub fn predicted_colour(i: usize) -> RGBColor {
+    let RGBColor(r, g, b) = colour(i);
+    let dark = |v: u8| (f64::from(v) * 0.6).round() as u8;
+    RGBColor(dark(r), dark(g), dark(b))
 }
 
 fn draw_overlay<DB: DrawingBackend>(
@@ -71,15 +81,17 @@ fn draw_overlay<DB: DrawingBackend>(
             .legend(move |(a, b)| PathElement::new(vec![(a, b), (a + 18, b)], col.stroke_width(2)));
     }
     for (i, c) in predicted.iter().enumerate() {
-        let col = colour(i).mix(0.9);
+        let col = predicted_colour(i);
         chart
-            .draw_series(LineSeries::new(
+            .draw_series(DashedLineSeries::new(
                 x.iter().copied().zip(c.values.iter().copied()),
-                BLACK.stroke_width(1),
+                7,
+                4,
+                col.stroke_width(2),
             ))
             .map_err(e2s)?
             .label(format!("{} predicted", c.label))
-            .legend(move |(a, b)| PathElement::new(vec![(a, b), (a + 18, b)], col.stroke_width(1)));
+            .legend(move |(a, b)| PathElement::new(vec![(a, b), (a + 18, b)], col.stroke_width(2)));
     }
     chart
         .configure_series_labels()
