@@ -199,6 +199,43 @@ impl AxisChain {
         }
     }
 
+    /// One revolution of a periodic waveform (N samples at spindle frequency `spindle_hz`) as the
+    /// chain records it: harmonic k times H(k·f_rev) (and times sinc²(πk/n_s) when the record,
+    /// n_s samples per revolution, was resampled onto the grid by linear interpolation), k < N/2.
+    pub fn apply_periodic(
+        &self,
+        values: &[f64],
+        spindle_hz: f64,
+        samples_per_rev: Option<f64>,
+    ) -> Vec<f64> {
+        let n = values.len();
+        if n < 2 || self.is_rigid() && samples_per_rev.is_none() {
+            return values.to_vec();
+        }
+        let mut planner = realfft::RealFftPlanner::<f64>::new();
+        let fwd = planner.plan_fft_forward(n);
+        let inv = planner.plan_fft_inverse(n);
+        let mut buf = values.to_vec();
+        let mut spec = fwd.make_output_vec();
+        fwd.process(&mut buf, &mut spec).expect("fft length");
+        for (k, s) in spec.iter_mut().enumerate().skip(1) {
+            let mut h = self.response_clamped(k as f64 * spindle_hz);
+            if let Some(spr) = samples_per_rev {
+                let x = std::f64::consts::PI * k as f64 / spr;
+                h *= (x.sin() / x).powi(2);
+            }
+            *s *= h;
+        }
+        if n.is_multiple_of(2) {
+            if let Some(s) = spec.last_mut() {
+                s.im = 0.0;
+            }
+        }
+        let mut out = inv.make_output_vec();
+        inv.process(&mut spec, &mut out).expect("fft length");
+        out.iter().map(|v| v / n as f64).collect()
+    }
+
     /// True for [`AxisChain::Rigid`].
     pub fn is_rigid(&self) -> bool {
         matches!(self, AxisChain::Rigid)

@@ -57,6 +57,10 @@ pub struct FullSignalOptions {
     /// Fit through a measuring chain (fitted modes, a known FRF or a band limit) in the
     /// harmonic domain ([`super::harmonic_fit`]); `None` = rigid sensor, time-domain fit.
     pub chain: Option<ChainOptions>,
+    /// Hold the cutting coefficients [K_tc, K_rc, K_ac, K_te, K_re, K_ae] at these values (only
+    /// with `chain`): a single recording cannot separate shear from edge coefficients, so the
+    /// per-recording runout fits hold those of the joint fit (issue 11 item 5).
+    pub fixed_coefficients: Option<[f64; 6]>,
 }
 
 /// Result of the full-signal fit. Offsets mm, angles rad, coefficients N/mm² and N/mm.

@@ -132,6 +132,8 @@ struct HarmonicProblem<'a> {
     data: Vec<CaseData>,
     models: Vec<RevolutionModel>,
     coef_idx: Vec<usize>,
+    /// Coefficients held fixed (all of them, when `coef_idx` is empty).
+    base_kc: [f64; 6],
     fit_tilt: bool,
     known: Option<MeasuringChain>,
     /// Fitted modes: axis per mode; parameters (ln f_n, ln ζ, g) in x (logs keep f_n, ζ > 0).
@@ -292,7 +294,7 @@ impl HarmonicProblem<'_> {
         self.x[1] = e[1] * 1e3;
     }
     fn coefficients(&self) -> CuttingCoefficients {
-        let mut a = [0.0; 6];
+        let mut a = self.base_kc;
         for (p, &i) in self.coef_idx.iter().enumerate() {
             a[i] = self.x[self.coef_start() + p];
         }
@@ -474,6 +476,9 @@ impl HarmonicProblem<'_> {
         x
     }
     fn linear_coefficients(&mut self) -> Result<(), IdentifyError> {
+        if self.coef_idx.is_empty() {
+            return Ok(());
+        }
         let x = self.coefficient_design();
         let (y, _) = self.measured_rows();
         let fit = linear_lsq("coefficients", &x, &DVector::from_vec(y))?;
@@ -805,7 +810,9 @@ pub(crate) fn harmonic_fit(
     let has_z = cases
         .iter()
         .any(|c| c.waveform.components.iter().any(|k| k.axis == Axis::Z));
-    let coef_idx: Vec<usize> = if has_z {
+    let coef_idx: Vec<usize> = if options.fixed_coefficients.is_some() {
+        vec![]
+    } else if has_z {
         vec![0, 1, 2, 3, 4, 5]
     } else {
         vec![0, 1, 3, 4]
@@ -841,6 +848,7 @@ pub(crate) fn harmonic_fit(
         data,
         models,
         coef_idx: coef_idx.clone(),
+        base_kc: options.fixed_coefficients.unwrap_or([0.0; 6]),
         fit_tilt: options.fit_tilt,
         known,
         mode_axes: mode_starts.iter().map(|m| m.0).collect(),
@@ -1062,7 +1070,7 @@ pub(crate) fn harmonic_fit(
         rigid_r_squared: rigid_r2,
     };
     let (e, tau) = p.runout();
-    let mut coefficients = [0.0; 6];
+    let mut coefficients = p.base_kc;
     let mut coefficient_se = [None; 6];
     for (j, &i) in coef_idx.iter().enumerate() {
         coefficients[i] = p.x[nr + j];

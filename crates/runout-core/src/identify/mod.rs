@@ -64,7 +64,7 @@ pub use multi_test::{analyse_tests, MultiTestResult, PeakTest, TestResult};
 pub use peak_coefficients::{coefficients_at_peak, PeakCoefficients};
 pub use pooled::{pooled_fit, EdgeModel, PooledFit};
 pub use sine_fit::{
-    peak_immersion, sine_fit, ErrorSource, Estimate, PeakConditions, SineFit, SineHypothesis,
-    ToothPeaks,
+    peak_immersion, radius_difference, sine_fit, ErrorSource, Estimate, PeakConditions, SineFit,
+    SineHypothesis, ToothPeaks,
 };
 pub use waveform::{AveragedWaveform, Axis, Component, WaveformCase};

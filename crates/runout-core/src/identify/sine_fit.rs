@@ -229,6 +229,52 @@ pub struct SineFit {
     pub warnings: Vec<String>,
 }
 
+/// K = 2 (issue 11 item 4): two peaks cannot give λ, but they give how unevenly the teeth cut —
+/// the radius difference R₀ − R₁ (mm) — with the proportional-peak model behind eq. (12): at
+/// the peak immersion γ, h₀,₁ = f_z·sin γ ± (R₀ − R₁) and F_i = C·h_i, so
+///
+/// R₀ − R₁ = f_z·sin γ·(F₀ − F₁)/(F₀ + F₁),
+///
+/// with its SE by the delta method from the per-tooth SEs (∂/∂F₀ = 2g·F₁/S², ∂/∂F₁ = −2g·F₀/S²,
+/// g = f_z sin γ, S = F₀ + F₁). Edge forces (a constant per tooth) bias it towards 0 as they bias
+/// the sine fit; it saturates at ±f_z·sin γ where the smaller tooth stops cutting.
+///
+/// ```
+/// use runout_core::identify::{radius_difference, PeakConditions, ToothPeaks};
+/// let peaks = ToothPeaks::new(vec![330.0, 270.0]).unwrap().with_se(vec![2.0, 2.0]).unwrap();
+/// let d = radius_difference(&peaks, &PeakConditions { fz_mm: 0.1, sin_gamma: 1.0 }).unwrap();
+/// assert!((d.value - 0.01).abs() < 1e-12); // 10 µm
+/// assert!(d.se.unwrap() > 0.0);
+/// ```
+pub fn radius_difference(
+    peaks: &ToothPeaks,
+    conditions: &PeakConditions,
+) -> Result<Estimate, IdentifyError> {
+    let f = peaks.values();
+    if f.len() != 2 {
+        return Err(IdentifyError::too_few(
+            "radius difference",
+            "exactly 2 teeth",
+            f.len(),
+        ));
+    }
+    let g = conditions.fz_mm * conditions.sin_gamma;
+    let sum = f[0] + f[1];
+    if sum.is_nan() || sum <= 0.0 || f[0] <= 0.0 || f[1] <= 0.0 {
+        return Err(IdentifyError::singular(
+            "radius difference",
+            format!("the peaks must be positive, got {} and {} N", f[0], f[1]),
+        ));
+    }
+    let value = g * (f[0] - f[1]) / sum;
+    let se = peaks.se().map(|se| {
+        let d0 = 2.0 * g * f[1] / (sum * sum);
+        let d1 = -2.0 * g * f[0] / (sum * sum);
+        (d0 * d0 * se[0] * se[0] + d1 * d1 * se[1] * se[1]).sqrt()
+    });
+    Ok(Estimate { value, se })
+}
+
 /// Fit F_i = C + A·sin(φ + 2πi/K) to per-tooth peaks and convert to runout (eq. 10–12).
 ///
 /// ```

@@ -90,6 +90,27 @@ pub const IDENTIFY_KEYS: &[(&str, Quantity, &str)] = &[
         Quantity::Dimensionless,
         "also fit the runout tilt (true/false) [default false]",
     ),
+    (
+        "chain",
+        Quantity::Dimensionless,
+        "measuring chain (sensor dynamics): auto | rigid | modes | frf | band [default auto: fit one \
+         mode per axis and use it where it explains the waveform significantly better]",
+    ),
+    (
+        "sensor_frf",
+        Quantity::Dimensionless,
+        "measured FRF file (CSV: freq_Hz, xx_re, xx_im, yy_re, yy_im[, zz_re, zz_im], H(0) = 1); implies chain = frf",
+    ),
+    (
+        "sensor_mode_hz",
+        Quantity::FrequencyHz,
+        "start value of the fitted sensor mode's natural frequency (Hz): one value, or x,y[,z] [default: scanned]",
+    ),
+    (
+        "max_harmonic",
+        Quantity::Dimensionless,
+        "band limit: fit only spindle harmonics 0..N (count) with a rigid model; implies chain = band",
+    ),
 ];
 
 /// Names of all keys.
@@ -120,6 +141,14 @@ pub struct IdentifyCase {
     pub tooth0_angle: Option<f64>,
     /// Fit the tilt too.
     pub fit_tilt: bool,
+    /// Measuring chain: auto | rigid | modes | frf | band.
+    pub chain: String,
+    /// Measured FRF file.
+    pub sensor_frf: Option<String>,
+    /// Start values of the fitted modes' natural frequencies (Hz): one, or per axis x, y[, z].
+    pub sensor_mode_hz: Option<Vec<f64>>,
+    /// Band limit (highest spindle harmonic).
+    pub max_harmonic: Option<usize>,
 }
 
 fn per_recording(s: &Settings, key: &str, n: usize) -> Result<Vec<f64>, ConfigError> {
@@ -199,6 +228,48 @@ pub fn resolve_identify(s: &Settings, recordings: usize) -> Result<IdentifyCase,
             })
         }
     };
+    let sensor_frf = s.text("sensor_frf")?;
+    let max_harmonic = s.count("max_harmonic")?;
+    let chain = match s.text("chain")?.map(|c| c.to_ascii_lowercase()) {
+        Some(c) => c,
+        None if sensor_frf.is_some() => "frf".into(),
+        None if max_harmonic.is_some() => "band".into(),
+        None => "auto".into(),
+    };
+    let chain_error = |message: String| ConfigError::Key {
+        source_name: s.origin("chain").unwrap_or("config").into(),
+        key: "chain".into(),
+        message,
+    };
+    if !["auto", "rigid", "modes", "frf", "band"].contains(&chain.as_str()) {
+        return Err(chain_error(format!(
+            "expected auto, rigid, modes, frf or band, got `{chain}`"
+        )));
+    }
+    if chain == "frf" && sensor_frf.is_none() {
+        return Err(chain_error(
+            "chain = frf needs sensor_frf (--sensor-frf FILE)".into(),
+        ));
+    }
+    let sensor_mode_hz = s.list("sensor_mode_hz", Quantity::FrequencyHz)?;
+    if let Some(v) = &sensor_mode_hz {
+        if v.is_empty() || v.len() > 3 || v.iter().any(|f| !(f.is_finite() && *f > 0.0)) {
+            return Err(ConfigError::Key {
+                source_name: s.origin("sensor_mode_hz").unwrap_or("config").into(),
+                key: "sensor_mode_hz".into(),
+                message: format!(
+                    "expected one natural frequency > 0 Hz, or one per axis x,y[,z], got {v:?}"
+                ),
+            });
+        }
+    }
+    if max_harmonic == Some(0) {
+        return Err(ConfigError::Key {
+            source_name: s.origin("max_harmonic").unwrap_or("config").into(),
+            key: "max_harmonic".into(),
+            message: "expected a spindle harmonic >= 1".into(),
+        });
+    }
     Ok(IdentifyCase {
         cutter,
         cuts,
@@ -212,5 +283,9 @@ pub fn resolve_identify(s: &Settings, recordings: usize) -> Result<IdentifyCase,
             .quantity("tooth0_angle_deg", Quantity::AngleDeg)?
             .map(f64::to_radians),
         fit_tilt,
+        chain,
+        sensor_frf,
+        sensor_mode_hz,
+        max_harmonic,
     })
 }

@@ -15,9 +15,9 @@ use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use runout_core::identify::{
     calibrate_mean_forces, full_signal_fit, harmonic_start_angle, model_forces, peak_immersion,
-    refine_start_angle, sine_fit, AveragedWaveform, Axis as FitAxis, Component as FitComponent,
-    FullSignalFit, FullSignalOptions, MeanForceCalibration, MeanForces, PeakConditions, SineFit,
-    SineHypothesis, ToothPeaks, WaveformCase,
+    radius_difference, refine_start_angle, sine_fit, AveragedWaveform, Axis as FitAxis,
+    Component as FitComponent, FullSignalFit, FullSignalOptions, MeanForceCalibration, MeanForces,
+    PeakConditions, SineFit, SineHypothesis, ToothPeaks, WaveformCase,
 };
 use runout_core::signal::{
     self, Component, PulseConfig, SignalAnalysis, SignalConfig, ToothReference,
@@ -37,6 +37,8 @@ use std::f64::consts::TAU;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
+
+mod chain;
 
 /// Arguments of `runout identify RECORDING…`.
 #[derive(clap::Args, Debug, Default)]
@@ -96,6 +98,22 @@ pub struct RecordingArgs {
     /// Also fit the runout tilt (µm/mm).
     #[arg(long)]
     pub fit_tilt: bool,
+    /// Measuring chain (the dynamometer's own dynamics): auto | rigid | modes | frf | band.
+    /// auto (default) fits one second-order mode per axis and uses it where it explains the
+    /// waveform significantly better; modes always; frf uses --sensor-frf; band fits only the
+    /// harmonics up to --max-harmonic (or an automatic limit below the resonance).
+    #[arg(long)]
+    pub chain: Option<String>,
+    /// Measured FRF of the dynamometer (CSV: freq_Hz, xx_re, xx_im, yy_re, yy_im[, zz_re, zz_im],
+    /// normalised to H(0) = 1); implies --chain frf.
+    #[arg(long)]
+    pub sensor_frf: Option<String>,
+    /// Start value of the sensor mode's natural frequency (Hz): one value, or x,y[,z].
+    #[arg(long)]
+    pub sensor_mode_hz: Option<String>,
+    /// Band limit: fit only spindle harmonics 0..N (count); implies --chain band.
+    #[arg(long)]
+    pub max_harmonic: Option<String>,
     /// Write the JSON result (`-` for stdout).
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -109,7 +127,11 @@ pub struct RecordingArgs {
 
 impl RecordingArgs {
     fn layer(&self) -> Layer {
-        let pairs: [(&str, &Option<String>); 15] = [
+        let pairs: [(&str, &Option<String>); 19] = [
+            ("chain", &self.chain),
+            ("sensor_frf", &self.sensor_frf),
+            ("sensor_mode_hz", &self.sensor_mode_hz),
+            ("max_harmonic", &self.max_harmonic),
             ("teeth", &self.teeth),
             ("diameter_mm", &self.diameter_mm),
             ("helix_deg", &self.helix_deg),
@@ -138,6 +160,15 @@ impl RecordingArgs {
             values,
         }
     }
+}
+
+/// What the chain selection, tooth numbering, consistency and verdicts gave.
+struct Extra {
+    decision: chain::ChainDecision,
+    given: Option<runout_core::chain::MeasuringChain>,
+    renumbered: Vec<(usize, usize)>,
+    consistency: Option<chain::Consistency>,
+    verdicts: Vec<chain::Status>,
 }
 
 /// What one recording gave.
@@ -186,18 +217,43 @@ pub fn run(a: RecordingArgs) -> Result<()> {
     for f in files.iter_mut() {
         f.start_angle = initial_start_angle(&case.cutter, f, &guess);
     }
-    let fit = fit_all(&case, &mut files);
-
-    let report = report_json(&case, &files, &calibration, &fit);
+    let rigid = fit_all(&case, &mut files);
+    // Tooth numbering consistent across the recordings of the joint fit, then the chain.
+    let mut renumbered = Vec::new();
+    if let (Ok(f), true) = (&rigid, files.len() > 1) {
+        renumbered = chain::align_tooth_numbering(&case, &mut files, f);
+    }
+    let rigid = if renumbered.is_empty() {
+        rigid
+    } else {
+        fit_all(&case, &mut files)
+    };
+    let (fit, decision, given) = chain::select_chain(&case, &mut files, rigid)?;
+    let consistency = fit
+        .as_ref()
+        .ok()
+        .and_then(|f| chain::consistency(&case, &files, f, given.as_ref()));
+    let verdicts = fit
+        .as_ref()
+        .map(|f| chain::verdicts(f, &decision, &files))
+        .unwrap_or_default();
+    let extra = Extra {
+        decision,
+        given,
+        renumbered,
+        consistency,
+        verdicts,
+    };
+    let report = report_json(&case, &files, &calibration, &fit, &extra);
     if let Some(j) = &a.json {
         output::write_text(j, &(serde_json::to_string_pretty(&report)? + "\n"))?;
     }
     if a.json.as_deref() != Some(Path::new("-")) {
-        print_text(&case, &files, &calibration, &fit);
+        print_text(&case, &files, &calibration, &fit, &extra);
     }
     if let Some(dir) = &a.plot_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        write_plots(dir, ext, &case, &files, &fit)?;
+        write_plots(dir, ext, &case, &files, &fit, &extra)?;
     }
     Ok(())
 }
@@ -597,9 +653,8 @@ fn waveform_case(cutter: &Cutter, f: &FileResult) -> WaveformCase {
 /// repeated until no start angle moves by more than 0.005° (at most 3 refits).
 fn fit_all(case: &IdentifyCase, files: &mut [FileResult]) -> Result<FullSignalFit, String> {
     let opts = FullSignalOptions {
-        disks: None,
         fit_tilt: case.fit_tilt,
-        initial_runout: None,
+        ..FullSignalOptions::default()
     };
     let cases = |files: &[FileResult]| {
         files
@@ -711,11 +766,38 @@ fn fit_json(fit: &Result<FullSignalFit, String>, files: &[FileResult]) -> Json {
     })
 }
 
+/// K = 2: the radius difference R₀ − R₁ from the two per-tooth peaks (the sine fit is
+/// degenerate there), µm ± SE.
+fn radius_difference_um(cutter: &Cutter, f: &FileResult) -> Option<(f64, Option<f64>)> {
+    if cutter.teeth() != 2 {
+        return None;
+    }
+    let p = &f.analysis.average.tooth_peaks;
+    let mut tp = ToothPeaks::new(p.iter().map(|p| p.peak).collect()).ok()?;
+    let se: Vec<f64> = p.iter().map(|p| p.se).collect();
+    if se.iter().all(|s| s.is_finite() && *s > 0.0) {
+        tp = tp.with_se(se).ok()?;
+    }
+    let cond = PeakConditions::new(f.cut.fz(), peak_immersion(cutter, &f.cut)).ok()?;
+    let d = radius_difference(&tp, &cond).ok()?;
+    Some((d.value * 1e3, d.se.map(|s| s * 1e3)))
+}
+
+/// R₀ − R₁ (µm) at the tool tip from a fitted runout (the full-signal check of the peak value).
+fn fitted_radius_difference_um(cutter: &Cutter, fit: &FullSignalFit) -> Option<f64> {
+    if cutter.teeth() != 2 {
+        return None;
+    }
+    let r = runout_core::Runout::new(fit.offset.value, fit.angle.value).ok()?;
+    Some((r.tooth_radius(cutter, 0, 0.0) - r.tooth_radius(cutter, 1, 0.0)) * 1e3)
+}
+
 fn report_json(
     case: &IdentifyCase,
     files: &[FileResult],
     cal: &Result<MeanForceCalibration, String>,
     fit: &Result<FullSignalFit, String>,
+    extra: &Extra,
 ) -> Json {
     let c = &case.cutter;
     let recs: Vec<Json> = files
@@ -743,6 +825,8 @@ fn report_json(
                 "peak_component": format!("{:?}", a.average.peak_component),
                 "tooth_peaks": a.average.tooth_peaks.iter().map(|p| json!({"tooth": p.tooth, "peak_N": p.peak, "peak_N_se": p.se, "spindle_angle_deg": p.angle.to_degrees()})).collect::<Vec<_>>(),
                 "sine_fit": sine_json(&f.sine),
+                "radius_difference_um": radius_difference_um(c, f).map(|d| d.0),
+                "radius_difference_um_se": radius_difference_um(c, f).and_then(|d| d.1),
                 "warnings": a.warnings.iter().chain(&f.reader_warnings).collect::<Vec<_>>(),
             })
         })
@@ -763,6 +847,14 @@ fn report_json(
         "recordings": recs,
         "mean_force_calibration": cal_json,
         "full_signal": fit_json(fit, files),
+        "measuring_chain": {
+            "decision": extra.decision,
+            "fit": fit.as_ref().ok().and_then(|f| f.chain.as_ref()),
+        },
+        "tooth_numbering_aligned": extra.renumbered.iter().map(|(c, j)| json!({"recording": c, "shifted_by_teeth": j})).collect::<Vec<_>>(),
+        "consistency": extra.consistency,
+        "status": extra.verdicts,
+        "fitted_radius_difference_um": fit.as_ref().ok().and_then(|f| fitted_radius_difference_um(c, f)),
     })
 }
 
@@ -785,6 +877,7 @@ fn print_text(
     files: &[FileResult],
     cal: &Result<MeanForceCalibration, String>,
     fit: &Result<FullSignalFit, String>,
+    extra: &Extra,
 ) {
     println!(
         "runout identify: K = {}, D = {} mm, helix {:.1}°",
@@ -834,6 +927,12 @@ fn print_text(
             ),
             Err(e) => println!("  sine fit (seed 003): not available: {e}"),
         }
+        if let Some((d, se)) = radius_difference_um(&case.cutter, f) {
+            println!(
+                "  radius difference R₀ − R₁ from the two peaks: {d:.2} {} µm (how unevenly the teeth cut; λ needs the full-signal fit)",
+                pm(se, 1.0, 2)
+            );
+        }
         for w in a.warnings.iter().chain(&f.reader_warnings) {
             println!("  warning: {w}");
         }
@@ -853,26 +952,66 @@ fn print_text(
         ),
         Err(e) => println!("\nmean-force calibration: skipped ({e})"),
     }
+    println!("measuring chain: {}", extra.decision.reason);
+    if let Ok(Some(c)) = fit.as_ref().map(|f| f.chain.as_ref()) {
+        for m in &c.modes {
+            println!(
+                "  mode on {:?}: {:.1} {} Hz, ζ {:.4} {}",
+                m.axis,
+                m.frequency_hz.value,
+                pm(m.frequency_hz.se, 1.0, 1),
+                m.damping.value,
+                pm(m.damping.se, 1.0, 4)
+            );
+        }
+        println!(
+            "  harmonics fitted: 0..{} of the spindle frequency; R² {:.4} (rigid model on the same band {:.4})",
+            c.max_harmonic.iter().max().unwrap_or(&0),
+            fit.as_ref().map(|f| f.r_squared).unwrap_or(f64::NAN),
+            c.rigid_r_squared
+        );
+    }
+    for (c, j) in &extra.renumbered {
+        println!(
+            "tooth numbering of {} shifted by {j} tooth pitch(es) to agree with the other recordings",
+            files[*c].path.display()
+        );
+    }
+    let status = |p: &str| extra.verdicts.iter().find(|v| v.parameter == p);
+    let shown = |p: &str| status(p).is_none_or(|v| v.status == "identified");
     match fit {
         Ok(f) => {
+            let head = if shown("offset") && shown("angle") {
+                "full-signal fit"
+            } else {
+                "full-signal fit (NOT IDENTIFIED, see below)"
+            };
             println!(
-                "full-signal fit: ρ = {:.2} {} µm, λ = {:.1} {}° (from tooth 0, in the rotation direction)",
+                "{head}: ρ = {:.2} {} µm, λ = {:.1} {}° (from tooth 0, in the rotation direction)",
                 f.offset.value * 1e3,
                 pm(f.offset.se, 1e3, 2),
                 f.angle.value.to_degrees(),
                 pm(f.angle.se, 1f64.to_degrees(), 1)
             );
+            if let Some(d) = fitted_radius_difference_um(&case.cutter, f) {
+                println!("  radius difference R₀ − R₁ of the fitted runout: {d:.2} µm");
+            }
             let names = ["K_tc", "K_rc", "K_ac", "K_te", "K_re", "K_ae"];
+            let keys = ["ktc", "krc", "kac", "kte", "kre", "kae"];
             let units = ["N/mm²", "N/mm²", "N/mm²", "N/mm", "N/mm", "N/mm"];
             let parts: Vec<String> = (0..6)
                 .map(|i| {
-                    format!(
-                        "{} {:.1} {} {}",
-                        names[i],
+                    let value = format!(
+                        "{:.1} {} {}",
                         f.coefficients[i],
                         pm(f.coefficient_se[i], 1.0, 1),
                         units[i]
-                    )
+                    );
+                    if f.coefficient_se[i].is_some() && !shown(keys[i]) {
+                        format!("{} not identified ({value})", names[i])
+                    } else {
+                        format!("{} {value}", names[i])
+                    }
                 })
                 .collect();
             println!("  {}", parts.join(", "));
@@ -890,6 +1029,33 @@ fn print_text(
             for w in &f.warnings {
                 println!("  warning: {w}");
             }
+            for v in extra.verdicts.iter().filter(|v| v.status != "identified") {
+                println!(
+                    "  not identified: {}: {}",
+                    v.parameter,
+                    v.reason.as_deref().unwrap_or("")
+                );
+            }
+            if let Some(c) = &extra.consistency {
+                println!(
+                    "  per recording (coefficients and chain of the joint fit held): ρ spread {:.1} %, λ spread {:.1}°",
+                    c.offset_spread_percent, c.angle_spread_deg
+                );
+                for r in &c.recordings {
+                    println!(
+                        "    {}: ρ = {:.2} {} µm, λ = {:.1} {}°{}",
+                        r.file,
+                        r.offset_um,
+                        pm(r.offset_um_se, 1.0, 2),
+                        r.angle_deg,
+                        pm(r.angle_deg_se, 1.0, 1),
+                        if r.disagrees { "  (DISAGREES)" } else { "" }
+                    );
+                }
+                for w in &c.warnings {
+                    println!("  warning: {w}");
+                }
+            }
         }
         Err(e) => println!("full-signal fit: failed: {e}"),
     }
@@ -901,6 +1067,7 @@ fn write_plots(
     case: &IdentifyCase,
     files: &[FileResult],
     fit: &Result<FullSignalFit, String>,
+    extra: &Extra,
 ) -> Result<()> {
     let mut marks = Vec::new();
     for (i, f) in files.iter().enumerate() {
@@ -929,13 +1096,25 @@ fn write_plots(
         if let Ok(fit) = fit {
             let kc = CuttingCoefficients::from_array(fit.coefficients);
             let tau = fit.tilt.map_or([0.0; 2], |t| [t[0].value, t[1].value]);
-            let pred = model_forces(
+            let mut pred = model_forces(
                 &waveform_case(&case.cutter, f),
                 f.start_angle,
                 [fit.vector[0].value, fit.vector[1].value],
                 tau,
                 &kc,
             );
+            // the model as the sensor records it (chain and resampling), when a chain was used
+            if fit.chain.is_some() {
+                let chain = chain::chain_of(fit, extra.given.as_ref());
+                let f_rev = f.analysis.speed.rpm / 60.0;
+                let spr = Some(f.info.sample_rate_hz / f_rev);
+                let band = matches!(extra.decision.used.as_str(), "band_limit");
+                for (p, axis) in pred.iter_mut().zip([&chain.x, &chain.y, &chain.z]) {
+                    if !band {
+                        *p = axis.apply_periodic(p, f_rev, spr);
+                    }
+                }
+            }
             let predicted = [
                 Curve {
                     label: "F_x (N)",
