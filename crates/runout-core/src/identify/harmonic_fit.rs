@@ -141,6 +141,8 @@ struct HarmonicProblem<'a> {
     fit_gain: bool,
     /// Gains of the modes when not fitted (kept out of x).
     fixed_gain: Vec<f64>,
+    /// ln of the highest natural frequency allowed: 1.2 × the top of the lowest fitted band.
+    max_mode_ln_hz: f64,
     /// Parameters: e (µm, 2) [, τ (µm/mm, 2)], coefficients, modes (3 each), δ (rad) per free case.
     x: DVector<f64>,
     /// Harmonics of the six basis sums per case: [r][k].
@@ -302,9 +304,11 @@ impl HarmonicProblem<'_> {
     }
     fn mode(&self, m: usize) -> SensorMode {
         let o = self.mode_offset(m);
-        // bounded so that a wild solver step cannot overflow: 1 Hz..10 MHz, ζ 1e-4..2
+        // bounded: f_n within the fitted band (a mode above it is not seen in the record, and the
+        // oversampled model would otherwise let a sharp one fold into the band: z at 20 kHz on a
+        // 10 kHz record), ζ 1e-4..2 so that a wild solver step cannot overflow
         SensorMode {
-            frequency_hz: self.x[o].clamp(0.0, 16.1).exp(),
+            frequency_hz: self.x[o].clamp(0.0, self.max_mode_ln_hz).exp(),
             damping: self.x[o + 1].clamp(-9.2, 0.7).exp(),
             gain: if self.fit_gain {
                 self.x[o + 2]
@@ -854,6 +858,7 @@ pub(crate) fn harmonic_fit(
         mode_axes: mode_starts.iter().map(|m| m.0).collect(),
         fit_gain,
         fixed_gain: vec![1.0; mode_starts.len()],
+        max_mode_ln_hz: 16.1,
         x: DVector::zeros(np),
         basis: Vec::new(),
         planner_cache,
@@ -861,6 +866,11 @@ pub(crate) fn harmonic_fit(
         freeze_runout: false,
         tooth_harmonics_only: None,
     };
+    p.max_mode_ln_hz = p
+        .data
+        .iter()
+        .map(|d| (1.2 * d.kmax as f64 * d.spindle_hz).ln())
+        .fold(16.1, f64::min);
     let n = p.n_residuals();
     if n <= np {
         return Err(IdentifyError::too_few(
@@ -1019,18 +1029,19 @@ pub(crate) fn harmonic_fit(
     let modes = (0..p.mode_axes.len())
         .map(|m| {
             let o = p.mode_offset(m);
+            let mode = p.mode(m);
             FittedMode {
                 axis: p.mode_axes[m],
                 frequency_hz: Estimate {
-                    value: p.x[o].exp(),
-                    se: Some(se(o) * p.x[o].exp()),
+                    value: mode.frequency_hz,
+                    se: Some(se(o) * mode.frequency_hz),
                 },
                 damping: Estimate {
-                    value: p.x[o + 1].exp(),
-                    se: Some(se(o + 1) * p.x[o + 1].exp()),
+                    value: mode.damping,
+                    se: Some(se(o + 1) * mode.damping),
                 },
                 gain: Estimate {
-                    value: p.mode(m).gain,
+                    value: mode.gain,
                     se: fit_gain.then(|| se(o + 2)),
                 },
             }

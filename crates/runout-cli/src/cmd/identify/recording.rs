@@ -168,7 +168,7 @@ struct Extra {
     given: Option<runout_core::chain::MeasuringChain>,
     renumbered: Vec<(usize, usize)>,
     consistency: Option<chain::Consistency>,
-    verdicts: Vec<chain::Status>,
+    verdicts: chain::Verdicts,
 }
 
 /// What one recording gave.
@@ -977,7 +977,7 @@ fn print_text(
             files[*c].path.display()
         );
     }
-    let status = |p: &str| extra.verdicts.iter().find(|v| v.parameter == p);
+    let status = |p: &str| extra.verdicts.parameters.iter().find(|v| v.parameter == p);
     let shown = |p: &str| status(p).is_none_or(|v| v.status == "identified");
     match fit {
         Ok(f) => {
@@ -1029,12 +1029,13 @@ fn print_text(
             for w in &f.warnings {
                 println!("  warning: {w}");
             }
-            for v in extra.verdicts.iter().filter(|v| v.status != "identified") {
-                println!(
-                    "  not identified: {}: {}",
-                    v.parameter,
-                    v.reason.as_deref().unwrap_or("")
-                );
+            for r in &extra.verdicts.fit {
+                println!("  NOT IDENTIFIED (any parameter): {r}");
+            }
+            for v in &extra.verdicts.parameters {
+                if let Some(r) = &v.reason {
+                    println!("  not identified: {}: {r}", v.parameter);
+                }
             }
             if let Some(c) = &extra.consistency {
                 println!(
