@@ -22,6 +22,10 @@ const AUTO_MIN_EFFECT: f64 = 0.02;
 /// 0.1 % point of F (≈ 7): a mode fitted to a rigid sensor's noise and model error reaches
 /// neither condition in the round-trip tests.
 const AUTO_MIN_F: f64 = 50.0;
+/// ... and at least one fitted mode must be a resonance (ζ ≤ 0.3): a heavily damped "mode" that
+/// improves the fit is absorbing model error (geometry), not describing the sensor (PHM 2010
+/// ball-end slice fitted as a flat end mill: ζ 1.35 on y).
+const AUTO_MAX_DAMPING: f64 = 0.3;
 
 /// What was decided about the measuring chain, as reported.
 #[derive(Debug, Clone, Serialize)]
@@ -263,9 +267,18 @@ pub(super) fn select_chain(
             ratio
         ),
     };
-    if requested == "auto" && !(f_stat >= AUTO_MIN_F && effect >= AUTO_MIN_EFFECT) {
+    let resonant = report
+        .modes
+        .iter()
+        .any(|m| m.gain.value != 0.0 && m.damping.value <= AUTO_MAX_DAMPING);
+    if requested == "auto" && !(f_stat >= AUTO_MIN_F && effect >= AUTO_MIN_EFFECT && resonant) {
         decision.used = "rigid".into();
-        decision.reason = if effect < AUTO_MIN_EFFECT {
+        decision.reason = if !resonant && effect >= AUTO_MIN_EFFECT {
+            format!(
+                "rigid: the fitted modes ({modes_text}) are too heavily damped to be a sensor \
+                 resonance (ζ > {AUTO_MAX_DAMPING}); they would only absorb model error"
+            )
+        } else if effect < AUTO_MIN_EFFECT {
             format!(
                 "rigid: no resonance reaching the tooth-passing harmonics (one mode per axis \
                  fitted: {modes_text}; |H − 1| ≤ {:.1} % there, below the {} % that would matter)",
