@@ -792,6 +792,34 @@ fn fitted_radius_difference_um(cutter: &Cutter, fit: &FullSignalFit) -> Option<f
     Some((r.tooth_radius(cutter, 0, 0.0) - r.tooth_radius(cutter, 1, 0.0)) * 1e3)
 }
 
+/// K = 2: the peaks' radius difference as a check of the full-signal fit (issue 11 item 4): a
+/// warning per recording where they disagree by more than max(3 SE, 30 % of the fitted value,
+/// 1 µm) — the proportional-peak model is biased by edge forces and helix smearing, hence the
+/// generous bound; a sign flip or a factor of two points at a wrong fit or tooth numbering.
+fn radius_difference_warnings(
+    cutter: &Cutter,
+    files: &[FileResult],
+    fit: &FullSignalFit,
+) -> Vec<String> {
+    let Some(d_fit) = fitted_radius_difference_um(cutter, fit) else {
+        return Vec::new();
+    };
+    files
+        .iter()
+        .filter_map(|f| {
+            let (d, se) = radius_difference_um(cutter, f)?;
+            let bound = (3.0 * se.unwrap_or(0.0)).max(0.3 * d_fit.abs()).max(1.0);
+            ((d - d_fit).abs() > bound).then(|| {
+                format!(
+                    "{}: the two peaks give R₀ − R₁ = {d:.2} µm, the full-signal fit {d_fit:.2} µm \
+                     (more than {bound:.2} µm apart): check the fit and the tooth numbering",
+                    f.path.display()
+                )
+            })
+        })
+        .collect()
+}
+
 fn report_json(
     case: &IdentifyCase,
     files: &[FileResult],
@@ -855,6 +883,7 @@ fn report_json(
         "consistency": extra.consistency,
         "status": extra.verdicts,
         "fitted_radius_difference_um": fit.as_ref().ok().and_then(|f| fitted_radius_difference_um(c, f)),
+        "radius_difference_warnings": fit.as_ref().map(|f| radius_difference_warnings(c, files, f)).unwrap_or_default(),
     })
 }
 
@@ -995,6 +1024,9 @@ fn print_text(
             );
             if let Some(d) = fitted_radius_difference_um(&case.cutter, f) {
                 println!("  radius difference R₀ − R₁ of the fitted runout: {d:.2} µm");
+                for w in radius_difference_warnings(&case.cutter, files, f) {
+                    println!("  warning: {w}");
+                }
             }
             let names = ["K_tc", "K_rc", "K_ac", "K_te", "K_re", "K_ae"];
             let keys = ["ktc", "krc", "kac", "kte", "kre", "kae"];
