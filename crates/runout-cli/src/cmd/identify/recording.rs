@@ -1163,9 +1163,14 @@ fn write_plots(
                 },
             ];
             let title = format!(
-                "{}: averaged ({} rev) vs full-signal model",
+                "{}: averaged ({} rev) vs full-signal model{}",
                 file_label(&f.path),
-                avg.revolutions
+                avg.revolutions,
+                match extra.decision.used.as_str() {
+                    "rigid" => "",
+                    "band_limit" => " (rigid, fitted on the band)",
+                    _ => " through the measuring chain",
+                }
             );
             waveform_overlay(
                 &dir.join(format!("waveform_{i}.{ext}")),
