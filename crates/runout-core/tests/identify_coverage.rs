@@ -72,19 +72,7 @@ fn one(i: usize) -> Outcome {
         &chip,
         &Sampling::new((SETTLE + REVS) as f64, step, 1).unwrap(),
     );
-    let env = |k: &str, d: f64| {
-        std::env::var(k)
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(d)
-    };
-    let mode = AxisChain::Modes(vec![SensorMode::new(
-        env("COV_MODE_HZ", 6000.0),
-        env("COV_ZETA", 0.2),
-        1.0,
-    )
-    .unwrap()]);
-    let ar_level = env("COV_AR", 0.25);
+    let mode = AxisChain::Modes(vec![SensorMode::new(6000.0, 0.2, 1.0).unwrap()]);
     let fs_fine = 15_000.0 * OVERSAMPLE as f64;
     let white = Normal::new(0.0, 1.0).unwrap();
     let mut channel = |v: &[f64]| -> Vec<f64> {
