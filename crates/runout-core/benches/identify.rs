@@ -1,10 +1,18 @@
 //! Identification speed. Target (issue 3): full-signal identification of 20 averaged revolutions
 //! < 0.5 s. Same run: the building blocks as baselines — one evaluation of the one-revolution
 //! model, the frequency-domain estimate, the seed-003 sine fit, and simulating the recording.
+//!
+//! Group `identify_chain` (issue 11 target: the joint fit of five recordings with a fitted mode
+//! ≤ 1 s, reported as a ratio to the rigid fit of the same data in the same run): the 2-flute
+//! Ø20, helix 40°, slot a_p 4 mm, 7500 rpm, 12 kHz, five-feed data of `tests/identify_chain.rs`
+//! (ρ 10 µm, a 1100 Hz / ζ 0.03 mode on x and y, 2 % white + coloured noise, 20 revolutions
+//! averaged), fitted with `ChainModel::FitModes` (modes scanned, angle shifts free) and with the
+//! rigid `FullSignalOptions::default()`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{rngs::StdRng, SeedableRng};
 use rand_distr::{Distribution, Normal};
+use runout_core::chain::{AxisChain, MeasuringChain, SensorMode};
 use runout_core::identify::*;
 use runout_core::*;
 
@@ -84,5 +92,112 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+/// The five resonant recordings of `tests/identify_chain.rs` (same simulation and noise).
+fn chain_cases() -> Vec<WaveformCase> {
+    const OVERSAMPLE: usize = 8;
+    let mode = SensorMode::new(1100.0, 0.03, 1.0).unwrap();
+    let chain = MeasuringChain {
+        x: AxisChain::Modes(vec![mode]),
+        y: AxisChain::Modes(vec![mode]),
+        z: AxisChain::Rigid,
+    };
+    let cutter = Cutter::flat(20.0, 2, 40.0).unwrap();
+    let n = 96; // 12 kHz at 7500 rpm
+    let lag_deg = (4.0 * 40f64.to_radians().tan() / 10.0).to_degrees();
+    let disks = (lag_deg / 0.05).ceil() as usize;
+    let (settle, revs) = (5, 20);
+    [0.04, 0.06, 0.08, 0.10, 0.12]
+        .iter()
+        .enumerate()
+        .map(|(i, &fz)| {
+            let cut = Cut::new(7500.0, fz, 4.0)
+                .unwrap()
+                .radial(20.0, MillingMode::Slot, &cutter)
+                .unwrap();
+            let runout = Runout::new(0.010, 137f64.to_radians()).unwrap();
+            let model = ForceModel {
+                cutter: cutter.clone(),
+                runout,
+                cut,
+                coefficients: CuttingCoefficients::from_array([
+                    2100.0, 750.0, 0.0, 25.0, 35.0, 0.0,
+                ]),
+            };
+            let chip = ArcChip::new(&cutter, &runout, fz).unwrap();
+            let s = model.simulate(
+                &chip,
+                &Sampling::new(
+                    (settle + revs) as f64,
+                    360.0 / (n * OVERSAMPLE) as f64,
+                    disks,
+                )
+                .unwrap(),
+            );
+            let mut rng = StdRng::seed_from_u64(11 + i as u64);
+            let white = Normal::new(0.0, 1.0).unwrap();
+            let mut channel = |v: &[f64], axis: Axis| -> Vec<f64> {
+                let kept: Vec<f64> = chain
+                    .axis(axis)
+                    .filter(12_000.0 * OVERSAMPLE as f64, v)
+                    .into_iter()
+                    .step_by(OVERSAMPLE)
+                    .skip(settle * n)
+                    .take(revs * n)
+                    .collect();
+                let sigma = 0.02 * kept.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let mut ar = 0.0;
+                kept.iter()
+                    .map(|x| {
+                        ar = 0.9 * ar + (1.0f64 - 0.81).sqrt() * white.sample(&mut rng);
+                        x + sigma * white.sample(&mut rng) + 0.25 * sigma * ar
+                    })
+                    .collect()
+            };
+            let (fx, fy) = (channel(&s.fx, Axis::X), channel(&s.fy, Axis::Y));
+            WaveformCase {
+                cutter: cutter.clone(),
+                cut,
+                waveform: AveragedWaveform::average(0.0, n, &[(Axis::X, &fx), (Axis::Y, &fy)])
+                    .unwrap(),
+            }
+        })
+        .collect()
+}
+
+fn bench_chain(c: &mut Criterion) {
+    let cases = chain_cases();
+    let fitted = FullSignalOptions {
+        chain: Some(ChainOptions {
+            model: ChainModel::FitModes {
+                axes: vec![(Axis::X, None), (Axis::Y, None)],
+                fit_gain: false,
+            },
+            spindle_hz: vec![125.0; 5],
+            samples_per_rev: vec![None; 5],
+            free_start_angle: vec![true; 5],
+        }),
+        ..FullSignalOptions::default()
+    };
+    let t = std::time::Instant::now();
+    let fit = full_signal_fit(&cases, &fitted).unwrap();
+    eprintln!(
+        "fitted-mode fit of five recordings: {:.2} s, ρ {:.3} µm, R² {:.4}, {} evaluations, {} disks",
+        t.elapsed().as_secs_f64(),
+        fit.offset.value * 1e3,
+        fit.r_squared,
+        fit.evaluations,
+        fit.disks
+    );
+    let mut g = c.benchmark_group("identify_chain");
+    g.sample_size(10);
+    g.bench_function("five_recordings_fitted_mode", |b| {
+        b.iter(|| full_signal_fit(&cases, &fitted))
+    });
+    g.bench_function("five_recordings_rigid", |b| {
+        b.iter(|| full_signal_fit(&cases, &FullSignalOptions::default()))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_chain);
 criterion_main!(benches);

@@ -6,3 +6,4 @@ pub mod grind;
 pub mod identify;
 pub mod shank;
 pub mod simulate;
+pub mod simulate_sensor;

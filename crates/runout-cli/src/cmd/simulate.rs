@@ -116,6 +116,8 @@ pub struct Args {
     pub plot: Option<PathBuf>,
     #[command(flatten)]
     pub recording: RecordingFlags,
+    #[command(flatten)]
+    pub sensor: super::simulate_sensor::SensorFlags,
 }
 
 /// Options for writing the simulated cut as an instrument recording (a test or example input).
@@ -209,6 +211,16 @@ pub fn run(a: Args) -> Result<()> {
     ]);
     let s = settings(a.config.as_deref(), flags, &simulate_key_names())?;
     let mut case = resolve_simulate(&s)?;
+    let sensor = a.sensor.chain()?;
+    if sensor.is_some() && a.recording.recording.is_none() {
+        anyhow::bail!("--sensor-mode-hz / --sensor-frf: a sensor chain applies to the recording; give --recording FILE and --sample-rate-hz");
+    }
+    // with a sensor, the cut is simulated finer than the recording (see simulate_sensor)
+    let oversample = if sensor.is_some() {
+        super::simulate_sensor::OVERSAMPLE
+    } else {
+        1
+    };
     let rate = a
         .recording
         .sample_rate_hz
@@ -219,7 +231,7 @@ pub fn run(a: Args) -> Result<()> {
         if fs <= 0.0 {
             anyhow::bail!("--sample-rate-hz: expected a sample rate > 0 Hz, got {fs}");
         }
-        let step_deg = 360.0 * case.cut.rpm() / 60.0 / fs;
+        let step_deg = 360.0 * case.cut.rpm() / 60.0 / fs / oversample as f64;
         case.sampling =
             runout_core::Sampling::new(case.sampling.revolutions, step_deg, case.sampling.disks)
                 .map_err(|e| anyhow::anyhow!("--sample-rate-hz {fs}: {e}"))?;
@@ -246,9 +258,12 @@ pub fn run(a: Args) -> Result<()> {
     }
     if let Some(path) = &a.recording.recording {
         let fs = rate.ok_or_else(|| anyhow::anyhow!("--recording needs --sample-rate-hz"))?;
-        write_recording(path, fs, &series, &a.recording)?;
+        write_recording(path, fs, &series, &a.recording, sensor.as_ref())?;
     }
-    let summary = summary_json(&case, &series, &peaks);
+    let mut summary = summary_json(&case, &series, &peaks);
+    if let Some(sc) = &sensor {
+        summary["sensor"] = sc.json.clone();
+    }
     if let Some(j) = &a.json {
         output::write_text(j, &(serde_json::to_string_pretty(&summary)? + "\n"))?;
     }
@@ -290,6 +305,7 @@ fn write_recording(
     fs: f64,
     s: &ForceSeries,
     r: &RecordingFlags,
+    sensor: Option<&super::simulate_sensor::SensorChain>,
 ) -> Result<()> {
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
@@ -308,17 +324,24 @@ fn write_recording(
     let sigma = pct / 100.0 * peak;
     let normal = Normal::new(0.0, sigma.max(0.0)).map_err(|e| anyhow::anyhow!("noise: {e}"))?;
     let mut rng = rand::rngs::StdRng::seed_from_u64(r.seed);
-    let pad = (air * fs).round() as usize;
-    let mut channel = |v: &[f64]| -> Vec<f64> {
+    // with a sensor the series is OVERSAMPLE× finer than the recording: pad at the fine rate,
+    // run through the sensor, decimate; the noise goes in after the sensor
+    let fine = sensor.map_or(1, |_| super::simulate_sensor::OVERSAMPLE);
+    let pad = (air * fs).round() as usize * fine;
+    let mut channel = |v: &[f64], axis: usize| -> Vec<f64> {
         let mut out = vec![0.0; pad];
         out.extend_from_slice(v);
         out.extend(std::iter::repeat_n(0.0, pad));
+        if let Some(sc) = sensor {
+            let chain = [&sc.chain.x, &sc.chain.y, &sc.chain.z][axis];
+            out = super::simulate_sensor::through_sensor(chain, fs, &out);
+        }
         if sigma > 0.0 {
             out.iter_mut().for_each(|x| *x += normal.sample(&mut rng));
         }
         out
     };
-    let (fx, fy, fz) = (channel(&s.fx), channel(&s.fy), channel(&s.fz));
+    let (fx, fy, fz) = (channel(&s.fx, 0), channel(&s.fy, 1), channel(&s.fz, 2));
     let style = runout_io::export::TextStyle {
         delimiter,
         decimal_comma: r.decimal_comma,
@@ -329,11 +352,24 @@ fn write_recording(
         .map(|n| n.to_string_lossy().replace(".txt", ".dwd"))
         .unwrap_or_default();
     let noise = format!("{pct}% of peak |F_xy| ({sigma:.3} N)");
+    let sensor_text = sensor.map_or_else(
+        || "rigid".to_string(),
+        |sc| {
+            format!(
+                "{} - cut simulated {}x oversampled then filtered and decimated; noise after the sensor",
+                sc.description,
+                super::simulate_sensor::OVERSAMPLE
+            )
+            // the header line must stay one field whatever the delimiter
+            .replace([',', ';', '\t'], " ")
+        },
+    );
     let meta = [
         ("Filename", name.as_str()),
         ("Cycle No", "1"),
         ("Comment", "simulated by runout simulate"),
         ("Noise", noise.as_str()),
+        ("Sensor", sensor_text.as_str()),
     ];
     let chans = [
         runout_io::export::Channel {

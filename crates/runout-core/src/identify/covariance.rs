@@ -14,6 +14,26 @@
 //! that sits at the harmonics where a parameter draws its information inflates that parameter's
 //! SE; a misfit elsewhere does not. Time-domain residuals are first rotated to harmonics by an
 //! orthonormal real DFT per component block (which leaves JᵀJ and Jᵀr unchanged).
+//!
+//! **Small-sample factor.** The robust variance of a quantity gᵀx is a weighted sum of one
+//! term per harmonic, each with one degree of freedom (the residual's projection on that
+//! quantity's row weights w = J(JᵀJ)⁻¹g). A parameter such as ρ draws its information from a
+//! handful of harmonics (the runout lines k ≢ 0 mod K), so that sum has few effective degrees of
+//! freedom, is skewed, and is low more often than high: in the Monte-Carlo test
+//! `tests/identify_coverage.rs` (an unmodelled 6 kHz mode, coloured noise, 200 recordings) ±2 SE
+//! of ρ covered the truth in 85 % of the fits (and the classic SE in 80 %). As for
+//! cluster-robust inference with few clusters (Satterthwaite, Bell–McCaffrey), the effective
+//! degrees of freedom are ν = (Σ_g b_g)²/Σ_g b_g², b_g = ‖w_g‖²·P̂_g the expected share of
+//! harmonic g, with P̂_g the leverage-corrected residual power per row averaged over the
+//! neighbouring harmonics g − W..g + W of the same component ([`SMOOTHING_HALF_WIDTH`], a
+//! Daniell estimate of the residual spectrum, so that a line with little residual by chance does
+//! not drop out of ν); the robust variance is multiplied by (t_ν(Φ(2))/2)², which makes ±2 SE
+//! cover what ±2σ of a normal covers. For many harmonics the factor tends to 1 (white-noise
+//! behaviour unchanged); in that test it raised the coverage to 90 % (robust) and 91.5 %
+//! (reported). (Smoothing the residual power into the meat itself, instead of the outer
+//! products, was tried and lowered the coverage to 75 %: the misfit at a runout line is larger
+//! than at its neighbours.)
+//!
 //! The reported SE of each parameter is the larger of the classic and the robust one.
 
 use nalgebra::{DMatrix, DVector};
@@ -23,7 +43,13 @@ use std::ops::Range;
 #[derive(Debug, Clone)]
 pub(crate) struct FitCovariance {
     pub classic: DMatrix<f64>,
+    /// The cluster sandwich, before the small-sample factor of [`FitCovariance::robust_var`].
     pub robust: DMatrix<f64>,
+    /// J·(JᵀJ)⁻¹ (n × p): row weights of each parameter's estimate.
+    ja: DMatrix<f64>,
+    /// Smoothed residual power per row of each cluster.
+    power: Vec<f64>,
+    groups: Vec<Cluster>,
     /// Condition number of the column-normalised Jacobian.
     pub condition: f64,
 }
@@ -31,15 +57,40 @@ pub(crate) struct FitCovariance {
 impl FitCovariance {
     /// SE of parameter i: the larger of the classic and the robust one.
     pub fn se(&self, i: usize) -> f64 {
-        self.classic[(i, i)]
-            .max(self.robust[(i, i)])
-            .max(0.0)
-            .sqrt()
+        let mut g = DVector::zeros(self.classic.nrows());
+        g[i] = 1.0;
+        self.se_of(&g)
     }
     /// SE of the linear combination gᵀx: the larger of the two.
     pub fn se_of(&self, g: &DVector<f64>) -> f64 {
-        let q = |c: &DMatrix<f64>| (g.transpose() * c * g)[(0, 0)];
-        q(&self.classic).max(q(&self.robust)).max(0.0).sqrt()
+        let [c, r] = self.se_parts_of(g);
+        c.max(r)
+    }
+    /// Robust variance of gᵀx with its small-sample factor: the sandwich estimate is a weighted
+    /// sum of one-degree-of-freedom terms, one per harmonic cluster, with effective degrees of
+    /// freedom ν = (Σb_g)²/Σb_g² (Satterthwaite; b_g = ‖(J(JᵀJ)⁻¹g)_g‖²·P̂_g the expected share
+    /// of cluster g). The variance is scaled by (t_ν(Φ(2))/2)² so that ±2 SE is the interval of
+    /// the same probability as ±2σ of a normal (a Student-t with ν degrees of freedom).
+    pub fn robust_var(&self, g: &DVector<f64>) -> f64 {
+        let v = (g.transpose() * &self.robust * g)[(0, 0)].max(0.0);
+        let w = &self.ja * g;
+        let (mut sum, mut sum2) = (0.0, 0.0);
+        for (c, p) in self.groups.iter().zip(&self.power) {
+            let b = w.rows(c.rows.start, c.rows.len()).norm_squared() * p;
+            sum += b;
+            sum2 += b * b;
+        }
+        let nu = if sum2 > 0.0 {
+            sum * sum / sum2
+        } else {
+            f64::INFINITY
+        };
+        v * small_sample_factor(nu).powi(2)
+    }
+    /// Classic and robust SE of the linear combination gᵀx, separately.
+    pub fn se_parts_of(&self, g: &DVector<f64>) -> [f64; 2] {
+        let c = (g.transpose() * &self.classic * g)[(0, 0)].max(0.0).sqrt();
+        [c, self.robust_var(g).sqrt()]
     }
     /// Correlation matrix (of the robust covariance when it is valid, else the classic one).
     pub fn correlation(&self) -> Vec<Vec<f64>> {
@@ -53,19 +104,39 @@ impl FitCovariance {
     }
 }
 
-/// Row ranges of the harmonic clusters of a harmonic-domain residual vector: per case and
-/// component, one row for k = 0, then two rows (re, im) for each k = 1..=k_max.
-pub(crate) fn harmonic_groups(kmax: &[usize], components: &[usize]) -> Vec<Range<usize>> {
+/// Half-width W (harmonics) of the smoothing of the residual power behind the effective degrees
+/// of freedom: each harmonic's power is the mean over g − W..g + W of its component (module docs).
+pub(crate) const SMOOTHING_HALF_WIDTH: usize = 1;
+
+/// One harmonic cluster: its rows and the (case, component) block it belongs to; the clusters of
+/// a block are listed in harmonic order.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Cluster {
+    pub rows: Range<usize>,
+    pub block: usize,
+}
+
+/// The harmonic clusters of a harmonic-domain residual vector: per case and component, one row
+/// for k = 0, then two rows (re, im) for each k = 1..=k_max.
+pub(crate) fn harmonic_groups(kmax: &[usize], components: &[usize]) -> Vec<Cluster> {
     let mut out = Vec::new();
     let mut row = 0;
+    let mut block = 0;
     for (&km, &nc) in kmax.iter().zip(components) {
         for _ in 0..nc {
-            out.push(row..row + 1);
+            out.push(Cluster {
+                rows: row..row + 1,
+                block,
+            });
             row += 1;
             for _ in 1..=km {
-                out.push(row..row + 2);
+                out.push(Cluster {
+                    rows: row..row + 2,
+                    block,
+                });
                 row += 2;
             }
+            block += 1;
         }
     }
     out
@@ -77,13 +148,13 @@ pub(crate) fn time_blocks_to_harmonics(
     j: &DMatrix<f64>,
     r: &DVector<f64>,
     blocks: &[usize],
-) -> (DMatrix<f64>, DVector<f64>, Vec<Range<usize>>) {
+) -> (DMatrix<f64>, DVector<f64>, Vec<Cluster>) {
     let (n, np) = j.shape();
     let mut jo = DMatrix::zeros(n, np);
     let mut ro = DVector::zeros(n);
     let mut groups = Vec::new();
     let mut start = 0;
-    for &len in blocks {
+    for (block, &len) in blocks.iter().enumerate() {
         let basis = real_dft_basis(len);
         for (row, (b, _)) in basis.iter().enumerate() {
             let out = start + row;
@@ -96,12 +167,30 @@ pub(crate) fn time_blocks_to_harmonics(
         while row < len {
             let g = basis[row].1;
             let size = basis[row..].iter().take_while(|x| x.1 == g).count();
-            groups.push(start + row..start + row + size);
+            groups.push(Cluster {
+                rows: start + row..start + row + size,
+                block,
+            });
             row += size;
         }
         start += len;
     }
     (jo, ro, groups)
+}
+
+/// t_ν(Φ(2)) / 2: the factor that makes ±2 SE of a Student-t with ν degrees of freedom cover
+/// what ±2σ of a normal covers (97.7 % one-sided); 1 for ν → ∞, at most 10.
+fn small_sample_factor(nu: f64) -> f64 {
+    use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
+    if !(nu.is_finite() && nu > 0.0) {
+        return 1.0;
+    }
+    let p = Normal::new(0.0, 1.0)
+        .map(|n| n.cdf(2.0))
+        .unwrap_or(0.977_25);
+    StudentsT::new(0.0, 1.0, nu.max(0.5))
+        .map(|t| (t.inverse_cdf(p) / 2.0).clamp(1.0, 10.0))
+        .unwrap_or(1.0)
 }
 
 /// Orthonormal real DFT rows of length n with their harmonic index.
@@ -128,7 +217,7 @@ fn real_dft_basis(n: usize) -> Vec<(Vec<f64>, usize)> {
 pub(crate) fn fit_covariance(
     j: &DMatrix<f64>,
     r: &DVector<f64>,
-    groups: &[Range<usize>],
+    groups: &[Cluster],
 ) -> FitCovariance {
     let (n, np) = j.shape();
     let dof = n.saturating_sub(np).max(1) as f64;
@@ -156,11 +245,37 @@ pub(crate) fn fit_covariance(
     // (JᵀJ)⁻¹ in the original scaling
     let inv = DMatrix::from_fn(np, np, |a, c| inv_n[(a, c)] / (norms[a] * norms[c]));
     let classic = &inv * s2;
+    // leverage-corrected residual power per row of each cluster (HC2)
+    let power: Vec<f64> = groups
+        .iter()
+        .map(|g| {
+            let len = g.rows.len();
+            let jg = j.rows(g.rows.start, len);
+            let h = (jg * &inv * jg.transpose()).trace() / len as f64;
+            r.rows(g.rows.start, len).norm_squared() / len as f64 / (1.0 - h.clamp(0.0, 0.9))
+        })
+        .collect();
+    let w = SMOOTHING_HALF_WIDTH;
+    let smoothed: Vec<f64> = (0..groups.len())
+        .map(|i| {
+            // Daniell mean over the neighbouring harmonics of the same block, weighted by rows
+            let lo = i.saturating_sub(w);
+            let hi = (i + w).min(groups.len() - 1);
+            let (mut sum, mut rows) = (0.0, 0.0);
+            for (k, gk) in groups.iter().enumerate().take(hi + 1).skip(lo) {
+                if gk.block == groups[i].block {
+                    sum += power[k] * gk.rows.len() as f64;
+                    rows += gk.rows.len() as f64;
+                }
+            }
+            sum / rows
+        })
+        .collect();
     let mut meat = DMatrix::zeros(np, np);
     for g in groups {
-        let jg = j.rows(g.start, g.len());
-        let rg = r.rows(g.start, g.len());
-        let h = (jg * &inv * jg.transpose()).trace() / g.len() as f64;
+        let jg = j.rows(g.rows.start, g.rows.len());
+        let rg = r.rows(g.rows.start, g.rows.len());
+        let h = (jg * &inv * jg.transpose()).trace() / g.rows.len() as f64;
         let scale = 1.0 / (1.0 - h.clamp(0.0, 0.9));
         let u = jg.transpose() * rg * scale;
         meat += &u * u.transpose();
@@ -169,6 +284,9 @@ pub(crate) fn fit_covariance(
     FitCovariance {
         classic,
         robust,
+        ja: j * &inv,
+        power: smoothed,
+        groups: groups.to_vec(),
         condition,
     }
 }
@@ -188,7 +306,7 @@ mod tests {
             assert!(d < 1e-10, "{d}");
             assert!((jo.transpose() * &ro - j.transpose() * &r).norm() < 1e-10);
             assert!((ro.norm() - r.norm()).abs() < 1e-12);
-            assert_eq!(groups.iter().map(|g| g.len()).sum::<usize>(), 2 * n);
+            assert_eq!(groups.iter().map(|g| g.rows.len()).sum::<usize>(), 2 * n);
             assert_eq!(groups.len(), 2 * (n / 2 + 1));
         }
     }

@@ -108,6 +108,19 @@ pub struct FullSignalFit {
     pub warnings: Vec<String>,
     /// The measuring chain of a chain-aware fit (`None` for the rigid time-domain fit).
     pub chain: Option<ChainFitReport>,
+    /// The two standard errors of ρ (mm) whose larger is `offset.se`: classic s²(JᵀJ)⁻¹ and
+    /// robust (harmonic-cluster sandwich), for diagnostics and the coverage test.
+    #[serde(skip)]
+    pub offset_se_parts: SeParts,
+}
+
+/// Classic and robust standard errors of one quantity (see [`super::covariance`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SeParts {
+    /// s²·(JᵀJ)⁻¹, independent residuals of equal variance.
+    pub classic: f64,
+    /// Harmonic-cluster sandwich.
+    pub robust: f64,
 }
 
 /// Which part of the runout vector the data determine.
@@ -884,5 +897,9 @@ pub(crate) fn fit_summary(s: FitSummaryInput<'_>) -> FullSignalFit {
         disks: s.disks,
         warnings,
         chain: None,
+        offset_se_parts: {
+            let [classic, robust] = s.cov.se_parts_of(&along(g_rho));
+            SeParts { classic, robust }
+        },
     }
 }

@@ -365,6 +365,32 @@ impl HarmonicProblem<'_> {
         }
         sum * d.interp[k]
     }
+    /// [`HarmonicProblem::fold`] of the six coefficient-gradient columns at once (the same sums
+    /// in the same order: identical values, with H and the gradient evaluated once per m).
+    fn fold_gradient(&self, c: usize, axis: Axis, k: usize) -> [Complex64; 6] {
+        let d = &self.data[c];
+        let top = OVERSAMPLE * d.n / 2;
+        let mut sum = [Complex64::new(0.0, 0.0); 6];
+        let mut add = |m: usize, conj: bool| {
+            let h = self.factor(c, axis, m);
+            let g = self.gradient_harmonic(c, axis, m);
+            for i in 0..6 {
+                let v = h * g[i];
+                sum[i] += if conj { v.conj() } else { v };
+            }
+        };
+        let mut m = k;
+        while m <= top {
+            add(m, false);
+            m += d.n;
+        }
+        let mut m = d.n;
+        while m >= k && m - k <= top {
+            add(m - k, true);
+            m += d.n;
+        }
+        sum.map(|v| v * d.interp[k])
+    }
     /// H(m·f_rev)·e^{imδ} of case c, axis, true harmonic m (only e^{imδ} for the rigid
     /// comparison). A measured FRF is held at its last value above its range.
     fn factor(&self, c: usize, axis: Axis, k: usize) -> Complex64 {
@@ -466,10 +492,9 @@ impl HarmonicProblem<'_> {
         let mut row = 0;
         self.rows(|c, comp, k, s| {
             let axis = self.cases[c].waveform.components[comp].axis;
+            let folded = self.fold_gradient(c, axis, k);
             for (j, &i) in self.coef_idx.iter().enumerate() {
-                let v = self.fold(c, k, |m| {
-                    self.factor(c, axis, m) * self.gradient_harmonic(c, axis, m)[i]
-                });
+                let v = folded[i];
                 x[(row, j)] = v.re * s;
                 if k > 0 {
                     x[(row + 1, j)] = v.im * s;
@@ -767,12 +792,29 @@ fn scan_modes(p: &mut HarmonicProblem<'_>, which: &[usize], teeth: usize, per_ax
     improved(p, end)
 }
 
+/// Basis harmonics of the rigid model at runout parameters (e [, τ]) already evaluated: the
+/// runout scan visits the same candidates up to three times with different chain parameters,
+/// and the basis depends on the runout (and the smooth/exact switch, fixed during the scans)
+/// only — so each candidate's model is evaluated once (identical results, a third of the work).
+type BasisCache = Vec<(Vec<f64>, Vec<Vec<Vec<Complex64>>>)>;
+
 /// Profile cost at each candidate runout vector (the rest of x as it is), best first.
-fn scan_runouts(p: &mut HarmonicProblem<'_>, candidates: &[[f64; 2]]) -> Vec<(f64, DVector<f64>)> {
+fn scan_runouts(
+    p: &mut HarmonicProblem<'_>,
+    candidates: &[[f64; 2]],
+    cache: &mut BasisCache,
+) -> Vec<(f64, DVector<f64>)> {
     let mut scored: Vec<(f64, DVector<f64>)> = Vec::new();
+    let nr = p.n_runout();
     for &e in candidates {
         p.set_runout(e);
-        p.recompute();
+        let key: Vec<f64> = (0..nr).map(|i| p.x[i]).collect();
+        if let Some((_, b)) = cache.iter().find(|(k, _)| *k == key) {
+            p.basis.clone_from(b);
+        } else {
+            p.recompute();
+            cache.push((key, p.basis.clone()));
+        }
         let c = p.profile_cost();
         if c.is_finite() {
             scored.push((c, p.x.clone()));
@@ -932,7 +974,8 @@ pub(crate) fn harmonic_fit(
         );
     }
     let mut starts = Vec::new();
-    let scored = scan_runouts(&mut p, &candidates);
+    let mut cache = BasisCache::new();
+    let scored = scan_runouts(&mut p, &candidates, &mut cache);
     if unstarted.is_empty() {
         // LM from the best scan point, and from the second when its cost is comparable (2×):
         // with edge skipping (large ρ, K = 2) the cost has local minima
@@ -949,7 +992,10 @@ pub(crate) fn harmonic_fit(
                 p.recompute();
             }
             scan_modes(&mut p, &unstarted, teeth, per_axis);
-            if let Some(best) = scan_runouts(&mut p, &candidates).into_iter().next() {
+            if let Some(best) = scan_runouts(&mut p, &candidates, &mut cache)
+                .into_iter()
+                .next()
+            {
                 starts.push(best);
             }
         }

@@ -51,7 +51,9 @@ mod waveform;
 pub use alignment::{harmonic_start_angle, model_forces, refine_start_angle, residual_at};
 pub use error::IdentifyError;
 pub use frequency::{frequency_estimate, FrequencyEstimate};
-pub use full_signal::{full_signal_fit, FullSignalFit, FullSignalOptions, RunoutObservability};
+pub use full_signal::{
+    full_signal_fit, FullSignalFit, FullSignalOptions, RunoutObservability, SeParts,
+};
 pub use harmonic_fit::{ChainFitReport, ChainModel, ChainOptions, FittedMode};
 pub use lsq::{fit_line, linear_lsq, r_squared, LinearFit, Regression};
 pub use mean_force::{
