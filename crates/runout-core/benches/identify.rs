@@ -8,6 +8,16 @@
 //! (ρ 10 µm, a 1100 Hz / ζ 0.03 mode on x and y, 2 % white + coloured noise, 20 revolutions
 //! averaged), fitted with `ChainModel::FitModes` (modes scanned, angle shifts free) and with the
 //! rigid `FullSignalOptions::default()`.
+//!
+//! Recorded 2026-11-25 on the shared 2-core box (load average ≈ 5, so absolute times are
+//! inflated): fitted mode 5.63 s vs rigid 0.52 s (ratio 10.8) before, 3.90 s vs 0.81 s after
+//! the scan cache and the one-pass coefficient fold (ratio ≈ 5–7 depending on load). The 1 s
+//! target is not met. Where the time goes (stage timings of one fit, same load): the runout
+//! scan 20 %, mode and runout rescans 6 %, Levenberg–Marquardt (two starts, 45 evaluations plus
+//! four model evaluations per Jacobian for the runout differences) 45 %, the exact-model
+//! compass refinement (194 evaluations) 30 %; in a profile ≈ 70 % of all time is the rigid
+//! model kernel (`RevolutionModel::compute`) on the 4× oversampled grid: 384 angles × 193 disks
+//! × 2 teeth × 5 recordings per evaluation, 4× the rigid fit's grid.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{rngs::StdRng, SeedableRng};

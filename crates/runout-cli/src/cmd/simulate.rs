@@ -356,7 +356,7 @@ fn write_recording(
         || "rigid".to_string(),
         |sc| {
             format!(
-                "{} - cut simulated {}x oversampled then filtered and decimated; noise after the sensor",
+                "{} - cut simulated {}x oversampled then filtered and decimated - noise after the sensor",
                 sc.description,
                 super::simulate_sensor::OVERSAMPLE
             )

@@ -23,7 +23,8 @@ pub struct SensorFlags {
     /// Simulated sensor mode: natural frequency f_n (Hz) of one second-order mode on every force
     /// axis, or per axis as a comma list `x,y,z` (e.g. `1100,1300,2500`; `rigid` for an axis
     /// without a mode). The cut is then simulated 8× oversampled, filtered by the mode, decimated
-    /// to --sample-rate-hz, and the noise is added after the sensor. Needs --recording.
+    /// to --sample-rate-hz, and the noise is added after the sensor (--out, --json peaks and
+    /// --plot then show the oversampled cut itself, without the sensor). Needs --recording.
     #[arg(long, allow_hyphen_values = true)]
     pub sensor_mode_hz: Option<String>,
     /// Damping ratio ζ of the sensor mode(s) (dimensionless, 0 < ζ < 1), one value for every axis
