@@ -345,3 +345,77 @@ fn two_flutes_band_limit_below_a_low_mode_reports_its_uncertainty() {
     );
     assert!((rho - s.rho_um).abs() <= 2.0 * se, "ρ {rho} ± {se}");
 }
+
+/// Issue 11 acceptance: the runout is consistent across five feeds when fitted per recording
+/// with the joint fit's coefficients and chain held (a single recording cannot separate shear
+/// from edge coefficients): spread of ρ ≤ 10 %, of λ ≤ 5°. A single recording's information on
+/// the runout scales with ρ/f_z (the noise is a fraction of the force, which grows with f_z),
+/// and with two teeth the offset across the tooth line is seen only through the helix lag: at
+/// f_z 0.10–0.12 mm one recording gives SE(λ) ≈ 100° (measured), so the per-recording check uses
+/// five feeds from 0.02 to 0.06 mm (SE(λ) 2–10°), where it is meaningful.
+#[test]
+fn per_recording_runout_is_consistent_across_feeds() {
+    let s = two_flute();
+    let cases: Vec<WaveformCase> = [0.02, 0.03, 0.04, 0.05, 0.06]
+        .iter()
+        .enumerate()
+        .map(|(i, &fz)| recording(&s, fz, &xy_mode(s.sensor), 31 + i as u64))
+        .collect();
+    let joint = full_signal_fit(&cases, &chain_options(&s, fitted_modes(), false)).unwrap();
+    let modes = &joint.chain.as_ref().unwrap().modes;
+    let mode_of = |a: Axis| {
+        modes
+            .iter()
+            .find(|m| m.axis == a)
+            .map_or(AxisChain::Rigid, |m| {
+                AxisChain::Modes(vec![SensorMode::new(
+                    m.frequency_hz.value,
+                    m.damping.value,
+                    m.gain.value,
+                )
+                .unwrap()])
+            })
+    };
+    let chain = MeasuringChain {
+        x: mode_of(Axis::X),
+        y: mode_of(Axis::Y),
+        z: AxisChain::Rigid,
+    };
+    let mut rho = Vec::new();
+    let mut lam = Vec::new();
+    for case in &cases {
+        let opts = FullSignalOptions {
+            chain: Some(ChainOptions {
+                model: ChainModel::Known(chain.clone()),
+                spindle_hz: vec![s.rpm / 60.0],
+                samples_per_rev: vec![None],
+                free_start_angle: vec![false],
+            }),
+            initial_runout: Some([joint.vector[0].value, joint.vector[1].value]),
+            fixed_coefficients: Some(joint.coefficients),
+            ..FullSignalOptions::default()
+        };
+        let fit = full_signal_fit(std::slice::from_ref(case), &opts).unwrap();
+        eprintln!(
+            "fz {}: ρ {:.3} ± {:.3} µm, λ {:.2} ± {:.2}°",
+            case.cut.fz(),
+            fit.offset.value * 1e3,
+            fit.offset.se.unwrap() * 1e3,
+            fit.angle.value.to_degrees(),
+            fit.angle.se.unwrap().to_degrees()
+        );
+        rho.push(fit.offset.value * 1e3);
+        lam.push(fit.angle.value.to_degrees());
+    }
+    let mean = rho.iter().sum::<f64>() / rho.len() as f64;
+    let spread =
+        rho.iter().cloned().fold(f64::MIN, f64::max) - rho.iter().cloned().fold(f64::MAX, f64::min);
+    let lspread =
+        lam.iter().cloned().fold(f64::MIN, f64::max) - lam.iter().cloned().fold(f64::MAX, f64::min);
+    assert!(
+        spread / mean <= 0.10,
+        "ρ spread {:.1} %",
+        100.0 * spread / mean
+    );
+    assert!(lspread <= 5.0, "λ spread {lspread:.2}°");
+}
