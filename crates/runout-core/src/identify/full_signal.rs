@@ -419,7 +419,7 @@ fn pattern_search(p: &mut Problem<'_>) -> usize {
     let (e, _) = p.runout();
     let step = (0.05 * e[0].hypot(e[1]) * 1e3).max(0.5);
     let start: Vec<f64> = (0..nr).map(|k| x0[k]).collect();
-    let (best, evals) = compass_search(&start, &dirs, step, |t| {
+    let (best, evals) = compass_search(&start, &dirs, step, 0.005, |t| {
         let mut x = p.x.clone();
         for (k, v) in t.iter().enumerate() {
             x[k] = *v;
@@ -437,19 +437,20 @@ fn pattern_search(p: &mut Problem<'_>) -> usize {
 }
 
 /// Compass (pattern) search: from `x0` try ± `step`·d along each direction d, take the first
-/// improvement, halve the step when none improves; stop below 0.005 (µm) or after 600
+/// improvement, halve the step when none improves; stop below `min_step` (µm) or after 600
 /// evaluations. Returns the best point and the number of cost evaluations.
 pub(crate) fn compass_search(
     x0: &[f64],
     dirs: &[Vec<f64>],
     step0: f64,
+    min_step: f64,
     mut cost: impl FnMut(&[f64]) -> f64,
 ) -> (Vec<f64>, usize) {
     let mut x = x0.to_vec();
     let mut best = cost(&x);
     let mut step = step0;
     let mut evals = 1;
-    while step > 0.005 && evals < 600 {
+    while step > min_step && evals < 600 {
         let mut moved = false;
         for d in dirs {
             for sign in [1.0, -1.0] {
