@@ -894,7 +894,8 @@ pub(crate) fn harmonic_fit(
     // Stage 1 (scans and LM from rough starts) runs on a model with 5× coarser disks (helix lag
     // ≤ 0.5° per disk): it only has to bring every parameter near the optimum, which stage 2
     // then refines on the full model (the compass search and LM there are local). Measured on
-    // the five-feed 2-flute bench: fitted-mode fit 3.9 s → see docs/measuring-chain.md.
+    // the five-feed 2-flute bench: fitted-mode fit 3.9 s → 1.35 s with the stage-2 changes below
+    // (docs/measuring-chain.md, "Speed").
     let coarse = build((disks / 5).max(1));
     let planner_cache = data
         .iter()
