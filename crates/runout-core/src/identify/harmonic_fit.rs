@@ -48,6 +48,8 @@ use std::f64::consts::PI;
 /// N-point sampling (a sharp entry or exit has harmonics far above N/2; applying H to the
 /// already-aliased N-point harmonics biased K_te by −3.5 % in the K = 4 down-milling round trip).
 const OVERSAMPLE: usize = 4;
+/// Oversampling of the stage-1 model (see [`harmonic_fit`]).
+const COARSE_OVERSAMPLE: usize = 2;
 
 /// How the measuring chain enters the full-signal fit.
 #[derive(Debug, Clone, PartialEq)]
@@ -148,6 +150,8 @@ struct HarmonicProblem<'a> {
     /// Harmonics of the six basis sums per case: [r][k].
     basis: Vec<Vec<Vec<Complex64>>>,
     planner_cache: Vec<std::sync::Arc<dyn realfft::RealToComplex<f64>>>,
+    /// Oversampling of the model grid of `models` (stage 1 coarser than stage 2).
+    oversample: usize,
     /// Rigid comparison: chain switched off (band kept).
     rigid: bool,
     /// Leave the runout columns of the Jacobian empty ([`RestProblem`]).
@@ -345,7 +349,7 @@ impl HarmonicProblem<'_> {
                 let mut buf: Vec<f64> = s.base.iter().map(|b| b[r]).collect();
                 let mut out = fft.make_output_vec();
                 fft.process(&mut buf, &mut out).expect("fft length");
-                out.iter().map(|v| v / OVERSAMPLE as f64).collect()
+                out.iter().map(|v| v / self.oversample as f64).collect()
             })
             .collect()
     }
@@ -354,7 +358,7 @@ impl HarmonicProblem<'_> {
     /// X_k = S_k·(Σ_{j≥0} Y_{k+jN} + Σ_{j≥1} conj(Y_{jN−k})).
     fn fold(&self, c: usize, k: usize, y: impl Fn(usize) -> Complex64) -> Complex64 {
         let d = &self.data[c];
-        let top = OVERSAMPLE * d.n / 2;
+        let top = self.oversample * d.n / 2;
         let mut sum = Complex64::new(0.0, 0.0);
         let mut m = k;
         while m <= top {
@@ -372,7 +376,7 @@ impl HarmonicProblem<'_> {
     /// in the same order: identical values, with H and the gradient evaluated once per m).
     fn fold_gradient(&self, c: usize, axis: Axis, k: usize) -> [Complex64; 6] {
         let d = &self.data[c];
-        let top = OVERSAMPLE * d.n / 2;
+        let top = self.oversample * d.n / 2;
         let mut sum = [Complex64::new(0.0, 0.0); 6];
         let mut add = |m: usize, conj: bool| {
             let h = self.factor(c, axis, m);
@@ -876,7 +880,7 @@ pub(crate) fn harmonic_fit(
     let nr = if options.fit_tilt { 4 } else { 2 };
     let per_mode = if fit_gain { 3 } else { 2 };
     let np = nr + coef_idx.len() + per_mode * mode_starts.len() + free;
-    let build = |disks: usize| -> Vec<RevolutionModel> {
+    let build = |disks: usize, ovs: usize| -> Vec<RevolutionModel> {
         cases
             .iter()
             .map(|c| {
@@ -884,23 +888,28 @@ pub(crate) fn harmonic_fit(
                     &c.cutter,
                     &c.cut,
                     c.waveform.start_angle,
-                    OVERSAMPLE * c.waveform.samples(),
+                    ovs * c.waveform.samples(),
                     disks,
                 )
             })
             .collect()
     };
-    let models = build(disks);
+    let models = build(disks, OVERSAMPLE);
     // Stage 1 (scans and LM from rough starts) runs on a model with 5× coarser disks (helix lag
     // ≤ 0.5° per disk): it only has to bring every parameter near the optimum, which stage 2
     // then refines on the full model (the compass search and LM there are local). Measured on
     // the five-feed 2-flute bench: fitted-mode fit 3.9 s → 1.35 s with the stage-2 changes below
     // (docs/measuring-chain.md, "Speed").
-    let coarse = build((disks / 5).max(1));
-    let planner_cache = data
-        .iter()
-        .map(|d| planner.plan_fft_forward(OVERSAMPLE * d.n))
-        .collect();
+    // (and on a 2× instead of 4× oversampled grid: 4× is needed for the final accuracy — 2×
+    // left ζ 9 % high in the K = 4 round trip — but not to get near the optimum)
+    let coarse = build((disks / 5).max(1), COARSE_OVERSAMPLE);
+    let mut plans = |ovs: usize| -> Vec<_> {
+        data.iter()
+            .map(|d| planner.plan_fft_forward(ovs * d.n))
+            .collect()
+    };
+    let planner_cache = plans(OVERSAMPLE);
+    let coarse_plans = plans(COARSE_OVERSAMPLE);
     let mut p = HarmonicProblem {
         cases,
         data,
@@ -916,6 +925,7 @@ pub(crate) fn harmonic_fit(
         x: DVector::zeros(np),
         basis: Vec::new(),
         planner_cache,
+        oversample: OVERSAMPLE,
         rigid: false,
         freeze_runout: false,
         tooth_harmonics_only: None,
@@ -948,6 +958,8 @@ pub(crate) fn harmonic_fit(
     // Start values: runout from the frequency-domain estimate (harmonic 1 is far below any
     // sensor mode), coefficients linear; modes without a start value scanned; then the runout scan.
     let full_models = std::mem::replace(&mut p.models, coarse);
+    let full_plans = std::mem::replace(&mut p.planner_cache, coarse_plans);
+    p.oversample = COARSE_OVERSAMPLE;
     p.set_smooth(true);
     p.linear_coefficients()?;
     let mut e_start = options.initial_runout.unwrap_or([0.0; 2]);
@@ -1033,6 +1045,8 @@ pub(crate) fn harmonic_fit(
         best.ok_or_else(|| IdentifyError::singular("chain fit", "no valid start value"))?;
     // Stage 2: exact model (see [`refine_on_exact_model`]).
     p.models = full_models;
+    p.planner_cache = full_plans;
+    p.oversample = OVERSAMPLE;
     p.recompute();
     p.linear_coefficients()?;
     let evals = refine_on_exact_model(&mut p, &unstarted, teeth)?;
