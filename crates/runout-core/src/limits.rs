@@ -18,7 +18,7 @@
 //! | depths a_p, a_e (mm) | (0, 1 000] | [`MAX_DEPTH_MM`] |
 //! | spindle speed (rpm) | (0, 1 000 000] | [`MAX_RPM`] |
 //! | runout ρ | < cutter radius R | [`runout_vs_radius`] |
-//! | text line (bytes) | ≤ 64 KiB | [`MAX_LINE_BYTES`] |
+//! | text line (bytes) | ≤ 1 MiB | [`MAX_LINE_BYTES`] |
 //! | header of a recording (bytes) | ≤ 1 MiB | [`MAX_HEADER_BYTES`] |
 //! | non-streaming table or config file (bytes) | ≤ 64 MiB | [`MAX_TABLE_BYTES`] |
 //! | chip/force evaluations of one command | ≤ 10¹⁰ | [`MAX_EVALUATIONS`] |
@@ -63,7 +63,7 @@ pub const MAX_DEPTH_MM: f64 = 1_000.0;
 /// Largest spindle speed (rpm).
 pub const MAX_RPM: f64 = 1.0e6;
 /// Longest line of a text file (bytes).
-pub const MAX_LINE_BYTES: usize = 64 * 1024;
+pub const MAX_LINE_BYTES: usize = 1024 * 1024;
 /// Largest header of a recording (bytes before the first data row).
 pub const MAX_HEADER_BYTES: usize = 1024 * 1024;
 /// Largest file read whole into memory (tables, configs, toolpaths, NC programs; bytes).

@@ -120,6 +120,18 @@ fn next_record(
 
 /// A whole (small) table in memory.
 fn read_table(path: &Path) -> Result<Table, TableError> {
+    let max = runout_core::limits::MAX_TABLE_BYTES;
+    if let Ok(m) = std::fs::metadata(path) {
+        if m.is_file() && m.len() > max {
+            return Err(TableError::File {
+                file: path.display().to_string(),
+                message: format!(
+                    "{} bytes: larger than the {max} bytes a table may have (limit MAX_TABLE_BYTES)",
+                    m.len()
+                ),
+            });
+        }
+    }
     let (mut t, mut rdr) = open_table(path)?;
     let mut records = rdr.records();
     while let Some(row) = next_record(&t, &mut records)? {

@@ -16,7 +16,7 @@ use std::path::Path;
 
 /// Error naming the file, line (and column) and what was expected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}:{line}{}: {message}", column.map(|c| format!(":{c}")).unwrap_or_default())]
+#[error("{file}{}{}: {message}", if *line > 0 { format!(":{line}") } else { String::new() }, column.map(|c| format!(":{c}")).unwrap_or_default())]
 pub struct PeakTableError {
     /// The file.
     pub file: String,
@@ -101,11 +101,11 @@ struct TomlTable {
 /// Read a peak table; the format follows the extension (`.toml`, else CSV/TSV).
 pub fn read_peak_table(path: &Path) -> Result<PeakTable, PeakTableError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| PeakTableError {
+    let text = crate::textfile::read_text(path).map_err(|e| PeakTableError {
         file: file.clone(),
-        line: 0,
+        line: e.line.unwrap_or(0),
         column: None,
-        message: format!("cannot read: {e}"),
+        message: e.message,
     })?;
     let is_toml = path
         .extension()

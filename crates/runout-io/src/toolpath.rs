@@ -71,9 +71,16 @@ pub enum ToolpathError {
 /// Read a toolpath; CSV when the extension is `.csv`, APT CL otherwise.
 pub fn read_toolpath(path: &Path) -> Result<Toolpath, ToolpathError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| ToolpathError::Io {
-        file: name.clone(),
-        source,
+    let text = crate::textfile::read_text(path).map_err(|e| match e.line {
+        Some(line) => ToolpathError::Parse {
+            file: name.clone(),
+            line,
+            message: e.message,
+        },
+        None => ToolpathError::Path {
+            file: name.clone(),
+            message: e.message,
+        },
     })?;
     let is_csv = path
         .extension()

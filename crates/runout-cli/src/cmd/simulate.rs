@@ -192,7 +192,7 @@ pub fn settings(
 ) -> Result<Settings> {
     let mut s = Settings::new();
     if let Some(path) = config {
-        let text = std::fs::read_to_string(path)
+        let text = runout_io::textfile::read_text(path)
             .with_context(|| format!("reading config {}", path.display()))?;
         s.push(layer_from_toml(&path.display().to_string(), &text, known)?);
     }

@@ -219,9 +219,12 @@ pub fn parse_case_specs(file: &str, text: &str) -> Result<Vec<ChipCaseSpec>, Chi
 /// Read and resolve every case of `path`.
 pub fn read_cases(path: &Path) -> Result<Vec<ChipCase>, ChipConfigError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| ChipConfigError::Io {
+    let text = crate::textfile::read_text(path).map_err(|e| ChipConfigError::Parse {
         file: file.clone(),
-        source,
+        message: match e.line {
+            Some(l) => format!("line {l}: {}", e.message),
+            None => e.message,
+        },
     })?;
     let base = path.parent().unwrap_or(Path::new("."));
     parse_case_specs(&file, &text)?
@@ -326,7 +329,7 @@ fn motion_of(s: &ChipCaseSpec, base: &Path) -> Result<(Motion, Vec<String>), Str
                 .ok_or("joints: required for motion joints")?;
             let full = base.join(file);
             let name = full.display().to_string();
-            let text = std::fs::read_to_string(&full).map_err(|e| format!("{name}: {e}"))?;
+            let text = crate::textfile::read_text(&full).map_err(|e| e.to_string())?;
             let blocks = parse_joint_csv(&name, &text).map_err(|e| e.to_string())?;
             let pts = joint_points(&name, &blocks, s.feed_mm_min).map_err(|e| e.to_string())?;
             let path = JointPath::new(&pts, s.pivot_mm).map_err(|e| format!("{name}: {e}"))?;

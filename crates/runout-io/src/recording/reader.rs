@@ -14,7 +14,7 @@ use std::path::Path;
 type Result<T> = std::result::Result<T, RecordingError>;
 
 /// Longest accepted line; a longer one is reported (bounded memory on garbage input).
-const MAX_LINE_BYTES: u64 = 1 << 20;
+const MAX_LINE_BYTES: u64 = runout_core::limits::MAX_LINE_BYTES as u64;
 /// Data rows inspected at open for the decimal separator and the time step.
 const PEEK_ROWS: usize = 1000;
 /// Default rows per chunk.
