@@ -1,0 +1,537 @@
+//! Issue 20: crashes, hangs, runaway memory and silent wrong answers. One regression test per
+//! row of the issue's table (the input as a file under `tests/data/issue20/` where it is a
+//! file), each asserting the exit code, the message's key words and that no input changed; and
+//! writing to a closed pipe on every command that prints.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command as StdCommand, Output, Stdio};
+use std::time::{Duration, Instant};
+
+mod common;
+use common::*;
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/issue20")
+        .join(name)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Run `runout args…`, returning its output and how long it took.
+fn run(args: &[&str]) -> (Output, Duration) {
+    let t = Instant::now();
+    let out = runout().args(args).output().unwrap();
+    (out, t.elapsed())
+}
+
+/// Assert a clean refusal: exit code 1 (no panic, no abort), the message holds every key word,
+/// no line of it is longer than `max_line` characters, and the files are unchanged.
+fn refused(args: &[&str], words: &[&str], unchanged: &[&Path]) -> String {
+    let before: Vec<Vec<u8>> = unchanged.iter().map(|p| std::fs::read(p).unwrap()).collect();
+    let (out, took) = run(args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for w in words {
+        assert!(err.contains(w), "{args:?}: `{w}` not in: {err}");
+    }
+    assert!(took < Duration::from_secs(20), "{args:?} took {took:?}");
+    for (p, b) in unchanged.iter().zip(before) {
+        assert_eq!(std::fs::read(p).unwrap(), b, "{} changed", p.display());
+    }
+    err
+}
+
+const SIMULATE: [&str; 17] = [
+    "simulate",
+    "--diameter-mm",
+    "10",
+    "--rpm",
+    "3240",
+    "--fz-mm",
+    "0.08",
+    "--ap-mm",
+    "1",
+    "--ae-mm",
+    "2",
+    "--mode",
+    "down",
+    "--ktc",
+    "1889.2",
+    "--krc",
+    "806.1",
+];
+
+fn simulate_with(extra: &[&str]) -> Vec<String> {
+    SIMULATE
+        .iter()
+        .chain(extra)
+        .map(|x| x.to_string())
+        .collect()
+}
+
+fn strs(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
+// ----------------------------------------------------------------------------------------------
+// rows 1–3, 9: chip case readers
+
+#[test]
+fn row01_apt_coordinate_1e300_is_a_range_error_naming_file_and_line() {
+    let case = data("coordinate_out_of_range.toml");
+    let apt = data("coordinate_out_of_range.apt");
+    let err = refused(
+        &["chip", "eval", s(&case)],
+        &[
+            "coordinate_out_of_range.apt:13",
+            "coordinate out of range",
+            "MAX_COORDINATE_MM",
+            "1e300",
+        ],
+        &[&case, &apt],
+    );
+    assert!(err.len() < 400, "{err}");
+}
+
+#[test]
+fn row02_apt_feed_1e_minus_300_is_refused_with_the_limit() {
+    let case = data("feed_too_small.toml");
+    let apt = data("feed_too_small.apt");
+    refused(
+        &["chip", "eval", s(&case)],
+        &["feed_too_small.apt:12", "FEDRAT", "MIN_FEED_MM_MIN", "1e-300"],
+        &[&case, &apt],
+    );
+}
+
+#[test]
+fn row03_chip_case_teeth_4e9_is_a_range_error_not_an_allocation_abort() {
+    let case = data("teeth_4e9.toml");
+    refused(
+        &["chip", "eval", s(&case)],
+        &["teeth", "MAX_TEETH", "4000000000"],
+        &[&case],
+    );
+}
+
+#[test]
+fn row09_apt_typo_got0_is_an_unknown_record_error_naming_the_line() {
+    let case = data("unknown_record.toml");
+    let apt = data("unknown_record.apt");
+    refused(
+        &["chip", "eval", s(&case)],
+        &["unknown_record.apt:13", "unknown APT record", "GOT0"],
+        &[&case, &apt],
+    );
+}
+
+// ----------------------------------------------------------------------------------------------
+// rows 4, 5, 15: simulate
+
+#[test]
+fn row04_simulate_teeth_1e6_is_a_range_error() {
+    let a = simulate_with(&["--teeth", "1000000"]);
+    refused(&strs(&a), &["teeth", "MAX_TEETH", "1000000"], &[]);
+}
+
+#[test]
+fn row05_simulate_many_teeth_refuses_with_the_work_or_finishes() {
+    let a = simulate_with(&["--teeth", "1000"]);
+    refused(&strs(&a), &["teeth", "MAX_TEETH", "1000"], &[]);
+    // within the teeth range, but too much work for the exact model: refused with the work
+    let a = simulate_with(&["--teeth", "200", "--helix-deg", "30", "--chip-model", "exact"]);
+    refused(&strs(&a), &["MAX_EVALUATIONS", "chip evaluations", "e11"], &[]);
+    // and a large but feasible cutter finishes quickly
+    let a = simulate_with(&["--teeth", "60"]);
+    let (out, took) = run(&strs(&a));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(took < Duration::from_secs(20));
+}
+
+#[test]
+fn row15_simulate_runout_9000_um_on_a_10_mm_cutter_is_refused() {
+    let a = simulate_with(&["--teeth", "4", "--runout-um", "9000"]);
+    refused(
+        &strs(&a),
+        &["runout_um", "below the cutter radius", "9000 µm"],
+        &[],
+    );
+    let a = simulate_with(&["--teeth", "4", "--runout-um", "4999"]);
+    assert!(run(&strs(&a)).0.status.success());
+}
+
+// ----------------------------------------------------------------------------------------------
+// rows 6, 7, 12: identify from recordings
+
+fn identify_inputs() -> [PathBuf; 3] {
+    [
+        example("identify/cut_fz0.05.txt"),
+        example("identify/cut_fz0.08.txt"),
+        example("identify/cut.toml"),
+    ]
+}
+
+#[test]
+fn row06_identify_ap_1e308_is_a_range_error() {
+    let [a, b, c] = identify_inputs();
+    refused(
+        &[
+            "identify",
+            s(&a),
+            s(&b),
+            "--config",
+            s(&c),
+            "--ap-mm",
+            "1e308",
+        ],
+        &["ap_mm", "MAX_DEPTH_MM", "1e308"],
+        &[&a, &b, &c],
+    );
+}
+
+#[test]
+fn row07_identify_fz_1e308_is_a_range_error_not_a_hang() {
+    let [a, b, c] = identify_inputs();
+    refused(
+        &[
+            "identify",
+            s(&a),
+            s(&b),
+            "--config",
+            s(&c),
+            "--fz-mm",
+            "1e308",
+        ],
+        &["fz_mm", "MAX_FZ_MM", "1e308"],
+        &[&a, &b, &c],
+    );
+}
+
+#[test]
+fn row12_identical_recordings_as_two_feeds_are_refused() {
+    let [a, _, c] = identify_inputs();
+    refused(
+        &[
+            "identify",
+            s(&a),
+            s(&a),
+            "--config",
+            s(&c),
+            "--fz-mm",
+            "0.05,0.08",
+        ],
+        &["recordings 1", "and 2", "identical"],
+        &[&a, &c],
+    );
+    // a copy under another name is the same recording too
+    let d = tempfile::tempdir().unwrap();
+    let copy = d.path().join("copy.txt");
+    std::fs::copy(&a, &copy).unwrap();
+    refused(
+        &[
+            "identify",
+            s(&a),
+            s(&copy),
+            "--config",
+            s(&c),
+            "--fz-mm",
+            "0.05,0.08",
+        ],
+        &["identical"],
+        &[&a, &copy],
+    );
+}
+
+// ----------------------------------------------------------------------------------------------
+// rows 13, 14: identify peaks
+
+const PEAKS: [&str; 10] = [
+    "identify",
+    "peaks",
+    "--teeth",
+    "4",
+    "--fz-mm",
+    "0.08",
+    "--ae-mm",
+    "2",
+    "--diameter-mm",
+    "10",
+];
+
+#[test]
+fn row13_all_zero_peaks_are_refused_not_nan() {
+    let mut a = PEAKS.to_vec();
+    a.extend(["--peaks-N", "0,0,0,0"]);
+    let err = refused(&a, &["peaks_N", "positive"], &[]);
+    assert!(!err.contains("NaN"), "{err}");
+}
+
+#[test]
+fn row14_negative_peaks_are_refused_never_a_negative_offset() {
+    let mut a = PEAKS.to_vec();
+    a.extend(["--peaks-N", "-366,-307,-259,-326"]);
+    refused(&a, &["peaks_N[0]", ">= 0 N", "-366"], &[]);
+}
+
+// ----------------------------------------------------------------------------------------------
+// row 8: shank
+
+#[test]
+fn row08_shank_reversed_air_cut_window_is_an_error_naming_the_key() {
+    let cfg = data("shank_reversed_air_cut.toml");
+    let rec = data("shank_recording.csv");
+    refused(
+        &["shank", "force", s(&rec), "--config", s(&cfg)],
+        &["air_cut_s[0]", "start < end", "[0.4, 0]"],
+        &[&cfg, &rec],
+    );
+    // a window past the end of the recording: a clear error, not a slice panic
+    let d = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(&cfg)
+        .unwrap()
+        .replace("[[0.4, 0.0]]", "[[0.4, 0.5]]");
+    let cfg2 = d.path().join("late.toml");
+    std::fs::write(&cfg2, text).unwrap();
+    refused(
+        &["shank", "force", s(&rec), "--config", s(&cfg2)],
+        &["air cut", "revolutions"],
+        &[&rec],
+    );
+}
+
+// ----------------------------------------------------------------------------------------------
+// rows 10, 11: grind compensate
+
+fn grind_args<'a>(probe: &'a str, edge: &'a str) -> Vec<&'a str> {
+    vec![
+        "grind",
+        "compensate",
+        "--probe",
+        probe,
+        "--bar-diameter-mm",
+        "6",
+        "--probe-tip-radius-mm",
+        "1",
+        "--edge",
+        edge,
+    ]
+}
+
+#[test]
+fn row10_nc_word_with_400_digits_is_an_error_naming_line_and_column() {
+    let probe = example("grind/probe.csv");
+    let edge = example("grind/edge.csv");
+    let nc = data("word_400_digits.nc");
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("out.nc");
+    let mut a = grind_args(s(&probe), s(&edge));
+    a.extend(["--nc", s(&nc), "--out", s(&out)]);
+    let err = refused(
+        &a,
+        &["word_400_digits.nc", "line 5, column 9", "out of range"],
+        &[&probe, &edge, &nc],
+    );
+    assert!(!err.contains("inf"), "{err}");
+    assert!(err.len() < 400, "the message quotes at most 80 characters: {err}");
+    assert!(!out.exists(), "no output on error");
+}
+
+#[test]
+fn row11_output_hard_linked_to_the_input_program_is_refused() {
+    let probe = example("grind/probe.csv");
+    let edge = example("grind/edge.csv");
+    let d = tempfile::tempdir().unwrap();
+    let nc = d.path().join("in.nc");
+    std::fs::copy(example("grind/flute.nc"), &nc).unwrap();
+    let link = d.path().join("link.nc");
+    std::fs::hard_link(&nc, &link).unwrap();
+    let mut a = grind_args(s(&probe), s(&edge));
+    a.extend(["--nc", s(&nc), "--out", s(&link)]);
+    refused(&a, &["refusing to write", "link.nc", "in.nc"], &[&nc, &probe, &edge]);
+    // the same for a JSON report and a symbolic link to the probe table
+    #[cfg(unix)]
+    {
+        let sym = d.path().join("probe_link.csv");
+        std::os::unix::fs::symlink(&probe, &sym).unwrap();
+        let mut a = grind_args(s(&probe), s(&edge));
+        a.extend(["--json", s(&sym)]);
+        refused(&a, &["refusing to write"], &[&probe]);
+    }
+    // a chip case's toolpath is an input too
+    let case = d.path().join("case.toml");
+    std::fs::copy(example("chip/flank_path.toml"), &case).unwrap();
+    let apt = d.path().join("flank.apt");
+    std::fs::copy(example("chip/flank.apt"), &apt).unwrap();
+    refused(
+        &["chip", "eval", s(&case), "--out", s(&apt)],
+        &["refusing to write", "flank.apt"],
+        &[&case, &apt],
+    );
+}
+
+// ----------------------------------------------------------------------------------------------
+// row 16: huge one-line tables
+
+#[test]
+fn row16_100_mb_one_line_table_is_refused_with_a_short_message() {
+    let d = tempfile::tempdir().unwrap();
+    let big = d.path().join("big.csv");
+    std::fs::write(&big, vec![b'a'; 100 * 1024 * 1024]).unwrap();
+    let long = d.path().join("long.csv");
+    std::fs::write(&long, vec![b'7'; 2 * 1024 * 1024]).unwrap();
+    for table in [&big, &long] {
+        let err = refused(&["identify", "tests", s(table)], &["limit MAX_"], &[]);
+        assert!(err.len() < 400, "{}", &err[..err.len().min(400)]);
+        let edge = example("grind/edge.csv");
+        let err = refused(&grind_args(s(table), s(&edge)), &["limit MAX_"], &[]);
+        assert!(err.len() < 400, "{}", &err[..err.len().min(400)]);
+    }
+    let err = refused(
+        &["identify", "tests", s(&long)],
+        &["long.csv:1", "MAX_LINE_BYTES"],
+        &[],
+    );
+    // the quote is at most 80 characters of the line
+    assert!(err.contains(&format!("`{}…`", "7".repeat(80))), "{err}");
+    assert!(!err.contains(&"7".repeat(81)), "{err}");
+}
+
+// ----------------------------------------------------------------------------------------------
+// broken pipes: every command that prints ends quietly (status 0 or SIGPIPE), never a panic
+
+fn closed_pipe(args: &[String]) {
+    let mut child = StdCommand::new(assert_cmd::cargo::cargo_bin("runout"))
+        .args(args)
+        .env("RUST_BACKTRACE", "0")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // the reader goes away at once, as with `| head -0`
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    #[cfg(unix)]
+    let killed_by_sigpipe = {
+        use std::os::unix::process::ExitStatusExt;
+        out.status.signal() == Some(13)
+    };
+    #[cfg(not(unix))]
+    let killed_by_sigpipe = false;
+    assert!(
+        out.status.success() || killed_by_sigpipe,
+        "{args:?}: {:?} {err}",
+        out.status
+    );
+    assert!(
+        !err.contains("panicked") && !err.contains("Broken pipe"),
+        "{args:?}: {err}"
+    );
+}
+
+#[test]
+fn broken_pipe_ends_quietly_on_every_command_that_prints() {
+    let d = tempfile::tempdir().unwrap();
+    let teeth = d.path().join("t.csv");
+    std::fs::write(
+        &teeth,
+        "seed_edge,reading_um\n1,253.850568\n2,250.916561\n3,245.307498\n",
+    )
+    .unwrap();
+    let heights = d.path().join("h.csv");
+    std::fs::write(&heights, "z_mm,tir_um\n1,6.8\n2,7.6\n3,8.4\n4,9.2\n").unwrap();
+    let e = |p: &str| example(p).to_str().unwrap().to_string();
+    let owned = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+    let mut cases: Vec<Vec<String>> = vec![
+        simulate_with(&["--teeth", "4"]),
+        simulate_with(&["--teeth", "4", "--out", "-"]),
+        simulate_with(&["--teeth", "4", "--json", "-"]),
+        owned(&[
+            "identify",
+            &e("identify/cut_fz0.05.txt"),
+            &e("identify/cut_fz0.08.txt"),
+            "--config",
+            &e("identify/cut.toml"),
+        ]),
+        owned(&[
+            "identify",
+            "peaks",
+            "--teeth",
+            "4",
+            "--fz-mm",
+            "0.08",
+            "--ae-mm",
+            "2",
+            "--diameter-mm",
+            "10",
+            "--peaks-N",
+            "366.6,307.9,259.9,326.6",
+        ]),
+        owned(&["identify", "tests", &e("seed003_table1.csv")]),
+        owned(&["chip", "eval", &e("chip/flank_path.toml")]),
+        owned(&["chip", "eval", &e("chip/flank_path.toml"), "--out", "-"]),
+        owned(&[
+            "displacement",
+            "teeth",
+            teeth.to_str().unwrap(),
+            "--teeth",
+            "3",
+            "--diameter-mm",
+            "0.5",
+            "--sensor",
+            "radial",
+            "--fz-mm",
+            "0.002",
+        ]),
+        owned(&["displacement", "heights", heights.to_str().unwrap()]),
+        owned(&[
+            "shank",
+            "stiffness",
+            "--modulus-gpa",
+            "210",
+            "--diameter-mm",
+            "8",
+            "--tool-length-mm",
+            "65",
+            "--l1-mm",
+            "10",
+            "--l2-mm",
+            "30",
+        ]),
+        owned(&["grind", "check"]),
+        owned(&[
+            "grind",
+            "compensate",
+            "--probe",
+            &e("grind/probe.csv"),
+            "--bar-diameter-mm",
+            "6",
+            "--probe-tip-radius-mm",
+            "1",
+            "--edge",
+            &e("grind/edge.csv"),
+        ]),
+        owned(&[
+            "grind",
+            "compensate",
+            "--probe",
+            &e("grind/probe.csv"),
+            "--bar-diameter-mm",
+            "6",
+            "--probe-tip-radius-mm",
+            "1",
+            "--edge",
+            &e("grind/edge.csv"),
+            "--path-out",
+            "-",
+        ]),
+        owned(&["--help"]),
+    ];
+    cases.push(owned(&["chip", "compare", &e("chip/flank_path.toml")]));
+    for c in &cases {
+        closed_pipe(c);
+    }
+}
