@@ -30,7 +30,10 @@ fn run(args: &[&str]) -> (Output, Duration) {
 /// Assert a clean refusal: exit code 1 (no panic, no abort), the message holds every key word,
 /// no line of it is longer than `max_line` characters, and the files are unchanged.
 fn refused(args: &[&str], words: &[&str], unchanged: &[&Path]) -> String {
-    let before: Vec<Vec<u8>> = unchanged.iter().map(|p| std::fs::read(p).unwrap()).collect();
+    let before: Vec<Vec<u8>> = unchanged
+        .iter()
+        .map(|p| std::fs::read(p).unwrap())
+        .collect();
     let (out, took) = run(args);
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
@@ -103,7 +106,12 @@ fn row02_apt_feed_1e_minus_300_is_refused_with_the_limit() {
     let apt = data("feed_too_small.apt");
     refused(
         &["chip", "eval", s(&case)],
-        &["feed_too_small.apt:12", "FEDRAT", "MIN_FEED_MM_MIN", "1e-300"],
+        &[
+            "feed_too_small.apt:12",
+            "FEDRAT",
+            "MIN_FEED_MM_MIN",
+            "1e-300",
+        ],
         &[&case, &apt],
     );
 }
@@ -143,12 +151,27 @@ fn row05_simulate_many_teeth_refuses_with_the_work_or_finishes() {
     let a = simulate_with(&["--teeth", "1000"]);
     refused(&strs(&a), &["teeth", "MAX_TEETH", "1000"], &[]);
     // within the teeth range, but too much work for the exact model: refused with the work
-    let a = simulate_with(&["--teeth", "200", "--helix-deg", "30", "--chip-model", "exact"]);
-    refused(&strs(&a), &["MAX_EVALUATIONS", "chip evaluations", "e11"], &[]);
+    let a = simulate_with(&[
+        "--teeth",
+        "200",
+        "--helix-deg",
+        "30",
+        "--chip-model",
+        "exact",
+    ]);
+    refused(
+        &strs(&a),
+        &["MAX_EVALUATIONS", "chip evaluations", "e11"],
+        &[],
+    );
     // and a large but feasible cutter finishes quickly
     let a = simulate_with(&["--teeth", "60"]);
     let (out, took) = run(&strs(&a));
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(took < Duration::from_secs(20));
 }
 
@@ -336,7 +359,10 @@ fn row10_nc_word_with_400_digits_is_an_error_naming_line_and_column() {
         &[&probe, &edge, &nc],
     );
     assert!(!err.contains("inf"), "{err}");
-    assert!(err.len() < 400, "the message quotes at most 80 characters: {err}");
+    assert!(
+        err.len() < 400,
+        "the message quotes at most 80 characters: {err}"
+    );
     assert!(!out.exists(), "no output on error");
 }
 
@@ -351,7 +377,11 @@ fn row11_output_hard_linked_to_the_input_program_is_refused() {
     std::fs::hard_link(&nc, &link).unwrap();
     let mut a = grind_args(s(&probe), s(&edge));
     a.extend(["--nc", s(&nc), "--out", s(&link)]);
-    refused(&a, &["refusing to write", "link.nc", "in.nc"], &[&nc, &probe, &edge]);
+    refused(
+        &a,
+        &["refusing to write", "link.nc", "in.nc"],
+        &[&nc, &probe, &edge],
+    );
     // the same for a JSON report and a symbolic link to the probe table
     #[cfg(unix)]
     {

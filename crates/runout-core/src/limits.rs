@@ -211,15 +211,27 @@ mod tests {
         assert!(teeth("teeth", 0).is_err());
         assert_eq!(teeth("teeth", 360), Ok(360));
         let e = coordinate("GOTO x", 1e300).unwrap_err().to_string();
-        assert!(e.contains("MAX_COORDINATE_MM") && e.contains("1e300"), "{e}");
+        assert!(
+            e.contains("MAX_COORDINATE_MM") && e.contains("1e300"),
+            "{e}"
+        );
         assert!(coordinate("x", f64::NAN).is_err());
         assert!(feed_mm_min("FEDRAT", 1e-300).is_err());
         assert!(runout_vs_radius("runout_um", 5.0, 5.0).is_err());
         assert!(runout_vs_radius("runout_um", 4.999, 5.0).is_ok());
-        let e = work("teeth", "evaluations", 2e10, MAX_EVALUATIONS, "MAX_EVALUATIONS")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("MAX_EVALUATIONS") && e.contains("2.000e10"), "{e}");
+        let e = work(
+            "teeth",
+            "evaluations",
+            2e10,
+            MAX_EVALUATIONS,
+            "MAX_EVALUATIONS",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("MAX_EVALUATIONS") && e.contains("2.000e10"),
+            "{e}"
+        );
         assert!(result_size("revolutions", 1e9, 1.0).is_err());
         assert!(result_size("revolutions", 1e6, 10.0).is_ok());
     }

@@ -175,11 +175,59 @@ fn apt_statements(text: &str) -> Vec<Statement> {
 
 /// APT statements that do not move the tool or set the feed: ignored without a warning.
 const IGNORED_APT: &[&str] = &[
-    "PARTNO", "CUTTER", "SPINDL", "LOADTL", "COOLNT", "FINI", "PPRINT", "INSERT", "REMARK",
-    "TLAXIS", "INTOL", "OUTTOL", "TOLER", "CLRSRF", "END", "STOP", "OPSTOP", "SELCTL", "TLON",
-    "TLOFF", "SET", "MACHIN", "PPFUN", "TITLE", "CUTCOM", "ORIGIN", "DELAY", "AUXFUN", "PREFUN",
-    "CLEARP", "RETRCT", "SEQNO", "NOPOST", "TRANS", "OPERATION", "OPNAME", "TOOL", "PIVOTZ",
-    "DISPLY", "LINTOL", "HEAD", "MODE", "THICK", "CYCLE", "DRAFT", "FROM",
+    "PARTNO",
+    "CUTTER",
+    "SPINDL",
+    "LOADTL",
+    "COOLNT",
+    "FINI",
+    "PPRINT",
+    "INSERT",
+    "REMARK",
+    "TLAXIS",
+    "INTOL",
+    "OUTTOL",
+    "TOLER",
+    "CLRSRF",
+    "END",
+    "STOP",
+    "OPSTOP",
+    "SELCTL",
+    "TLON",
+    "TLOFF",
+    "SET",
+    "MACHIN",
+    "PPFUN",
+    "TITLE",
+    "CUTCOM",
+    "ORIGIN",
+    "DELAY",
+    "AUXFUN",
+    "PREFUN",
+    "CLEARP",
+    "RETRCT",
+    "SEQNO",
+    "NOPOST",
+    "TRANS",
+    "OPERATION",
+    "OPNAME",
+    "TOOL",
+    "PIVOTZ",
+    "DISPLY",
+    "LINTOL",
+    "HEAD",
+    "MODE",
+    "THICK",
+    "CYCLE",
+    "DRAFT",
+    "FROM",
+    "END-OF-PATH",
+    "TPRINT",
+    "GOHOME",
+    "MSYS",
+    "RESET",
+    "ROTABL",
+    "ROTATE",
 ];
 
 /// At most 80 characters of `text` for a message.
@@ -243,7 +291,11 @@ impl Apt<'_> {
                 format!("{word}: circular moves are not supported; export linearised GOTO points"),
             )),
             w if IGNORED_APT.contains(&w) => Ok(()),
-            w if w.is_empty() || !w.chars().all(|c| c.is_ascii_alphabetic() || c == '_') => {
+            w if !w.starts_with(|c: char| c.is_ascii_alphabetic())
+                || !w
+                    .chars()
+                    .all(|c| c.is_ascii_alphabetic() || c == '_' || c == '-') =>
+            {
                 Err(self.err(
                     st.line,
                     format!(

@@ -202,7 +202,8 @@ struct Resolved {
 
 fn load_config(path: &Path, rate_flag: Option<&str>) -> Result<Resolved> {
     let file = path.display().to_string();
-    let text = runout_io::textfile::read_text(path).with_context(|| format!("reading config {file}"))?;
+    let text =
+        runout_io::textfile::read_text(path).with_context(|| format!("reading config {file}"))?;
     let cfg = ShankConfig::parse(&file, &text)?;
     let b = &cfg.shank;
     let n = |key: &str, v: &runout_io::config::Value, q| number(&file, key, v, q);

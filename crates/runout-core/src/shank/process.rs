@@ -162,11 +162,7 @@ impl ShankSetup {
                 return Err(p(
                     &format!("air_cut_s[{q}]"),
                     "a window [start, end] in s with 0 <= start < end",
-                    format!(
-                        "[{}, {}]",
-                        crate::limits::show(a),
-                        crate::limits::show(b)
-                    ),
+                    format!("[{}, {}]", crate::limits::show(a), crate::limits::show(b)),
                 ));
             }
         }

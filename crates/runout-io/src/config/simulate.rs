@@ -4,7 +4,8 @@
 use super::{ConfigError, Settings};
 use crate::units::Quantity;
 use runout_core::{
-    limits, Cut, Cutter, CuttingCoefficients, MillingMode, ParamError, RadiusProfile, Runout, Sampling,
+    limits, Cut, Cutter, CuttingCoefficients, MillingMode, ParamError, RadiusProfile, Runout,
+    Sampling,
 };
 
 /// Every key of a simulation case: (key, quantity, help). The CLI flag is `--key-with-dashes`.
@@ -312,7 +313,11 @@ impl SimulateCase {
     pub fn check_work(&self) -> Result<(), ConfigError> {
         let k = self.cutter.teeth() as f64;
         let n = self.sampling.revolutions * std::f64::consts::TAU / self.sampling.step;
-        let per = if self.chip_model == "exact" { k * k * k } else { k * k };
+        let per = if self.chip_model == "exact" {
+            k * k * k
+        } else {
+            k * k
+        };
         let evaluations = n * self.sampling.disks as f64 * per;
         let err = |e: ParamError| ConfigError::Key {
             source_name: "simulation size".into(),
