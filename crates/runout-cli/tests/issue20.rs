@@ -565,3 +565,99 @@ fn broken_pipe_ends_quietly_on_every_command_that_prints() {
         closed_pipe(c);
     }
 }
+
+// ----------------------------------------------------------------------------------------------
+// item 5: non-finite numbers anywhere in a parsed file are errors naming where
+
+#[test]
+fn non_finite_numbers_anywhere_in_a_parsed_file_are_errors() {
+    let d = tempfile::tempdir().unwrap();
+    let put = |name: &str, text: String| {
+        let p = d.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    // a chip case: a key the resolver would not check itself
+    let case = put(
+        "case.toml",
+        "[[case]]\nname = \"a\"\nteeth = 4\ndiameter_mm = 10\nrpm = 6000\nfz_mm = 0.1\n\
+         heights_mm = [0.0]\nstart_s = nan\n"
+            .into(),
+    );
+    refused(
+        &["chip", "eval", s(&case)],
+        &["case.toml", "start_s", "finite"],
+        &[&case],
+    );
+    // a nested array element
+    let case2 = put(
+        "case2.toml",
+        "[[case]]\nname = \"a\"\nteeth = 4\ndiameter_mm = 10\nrpm = 6000\nfz_mm = 0.1\n\
+         heights_mm = [0.0, inf]\n"
+            .into(),
+    );
+    refused(
+        &["chip", "eval", s(&case2)],
+        &["heights_mm[1]", "finite"],
+        &[&case2],
+    );
+    // a simulate case file
+    let sim = put(
+        "sim.toml",
+        "teeth = 4\ndiameter_mm = 10\nrpm = 3000\nfz_mm = 0.1\nap_mm = 1\nae_mm = 2\n\
+         mode = \"up\"\nktc = nan\nkrc = 800\n"
+            .into(),
+    );
+    refused(
+        &["simulate", s(&sim)],
+        &["sim.toml", "ktc", "finite"],
+        &[&sim],
+    );
+    // a probe table cell
+    let probe_text = std::fs::read_to_string(example("grind/probe.csv"))
+        .unwrap()
+        .replacen("4.008611", "nan", 1);
+    let probe = put("probe.csv", probe_text);
+    let edge = example("grind/edge.csv");
+    refused(
+        &grind_args(s(&probe), s(&edge)),
+        &["probe.csv", "x_mm", "nan", "finite"],
+        &[&probe],
+    );
+    // a peak table cell
+    let table_text = std::fs::read_to_string(example("seed003_table1.csv")).unwrap();
+    let first_data = table_text
+        .lines()
+        .find(|l| !l.starts_with('#') && l.starts_with(|c: char| c.is_ascii_digit()))
+        .unwrap()
+        .to_string();
+    let mut cells: Vec<&str> = first_data.split(',').collect();
+    cells[3] = "inf"; // peak0_N
+    let table = put(
+        "peaks.csv",
+        table_text.replacen(&first_data, &cells.join(","), 1),
+    );
+    refused(
+        &["identify", "tests", s(&table)],
+        &["peaks.csv", "not finite"],
+        &[&table],
+    );
+    // a shank config
+    let shank = put(
+        "shank.toml",
+        std::fs::read_to_string(data("shank_reversed_air_cut.toml"))
+            .unwrap()
+            .replace("modulus_gpa = 210", "modulus_gpa = nan"),
+    );
+    refused(
+        &[
+            "shank",
+            "force",
+            s(&data("shank_recording.csv")),
+            "--config",
+            s(&shank),
+        ],
+        &["shank.modulus_gpa", "finite"],
+        &[&shank],
+    );
+}

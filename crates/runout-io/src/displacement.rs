@@ -203,11 +203,16 @@ impl Table {
     /// Cell `col` of record `rec` (at `line`) as a finite number times the column's unit factor.
     fn cell(&self, line: u64, rec: &csv::StringRecord, col: &Column) -> Result<f64, TableError> {
         let text = rec.get(col.index).unwrap_or("");
+        let quoted = || crate::textfile::quote(text);
         let v: f64 = text
             .parse()
-            .map_err(|_| self.cell_error(line, col, format!("`{text}` is not a number")))?;
-        if !v.is_finite() {
-            return Err(self.cell_error(line, col, format!("`{text}` is not a finite number")));
+            .map_err(|_| self.cell_error(line, col, format!("`{}` is not a number", quoted())))?;
+        if !(v * col.factor).is_finite() {
+            return Err(self.cell_error(
+                line,
+                col,
+                format!("`{}` is not a finite number", quoted()),
+            ));
         }
         Ok(v * col.factor)
     }

@@ -119,6 +119,19 @@ pub fn read_peak_table(path: &Path) -> Result<PeakTable, PeakTableError> {
 
 /// Parse a TOML peak table.
 pub fn parse_toml(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
+    if let Ok(doc) = text.parse::<toml::Table>() {
+        if let Some(key) = doc
+            .iter()
+            .find_map(|(k, v)| crate::config::non_finite_key(v, k))
+        {
+            return Err(PeakTableError {
+                file: file.into(),
+                line: 0,
+                column: None,
+                message: format!("key `{key}`: expected a finite number, got nan or inf"),
+            });
+        }
+    }
     let t: TomlTable = toml::from_str(text).map_err(|e: toml::de::Error| {
         let mut line = e
             .span()
@@ -243,7 +256,11 @@ pub fn parse_csv(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
                 err(
                     line,
                     Some(c + 1),
-                    format!("`{t}` in column `{}` is not a number", &headers[c]),
+                    format!(
+                        "`{}` in column `{}` is not a number",
+                        crate::textfile::quote(t),
+                        &headers[c]
+                    ),
                 )
             })?;
             if v.is_finite() {
@@ -252,7 +269,11 @@ pub fn parse_csv(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
                 Err(err(
                     line,
                     Some(c + 1),
-                    format!("`{t}` in column `{}` is not finite", &headers[c]),
+                    format!(
+                        "`{}` in column `{}` is not finite",
+                        crate::textfile::quote(t),
+                        &headers[c]
+                    ),
                 ))
             }
         };

@@ -186,6 +186,11 @@ pub fn parse_case_specs(file: &str, text: &str) -> Result<Vec<ChipCaseSpec>, Chi
         message,
     };
     let mut doc: toml::Table = toml::from_str(text).map_err(|e| perr(e.to_string()))?;
+    if let Some(key) = doc.iter().find_map(|(k, v)| super::non_finite_key(v, k)) {
+        return Err(perr(format!(
+            "key `{key}`: expected a finite number, got nan or inf"
+        )));
+    }
     let defaults = match doc.remove("defaults") {
         Some(toml::Value::Table(t)) => t,
         Some(_) => return Err(perr("`defaults` must be a table".into())),

@@ -200,6 +200,41 @@ impl Settings {
     }
 }
 
+/// The key path of the first non-finite float (`nan`, `inf`) anywhere in a TOML value.
+pub(crate) fn non_finite_key(v: &toml::Value, path: &str) -> Option<String> {
+    match v {
+        toml::Value::Float(f) if !f.is_finite() => Some(path.to_string()),
+        toml::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| non_finite_key(x, &format!("{path}[{i}]"))),
+        toml::Value::Table(t) => t.iter().find_map(|(k, x)| {
+            let p = if path.is_empty() {
+                k.clone()
+            } else {
+                format!("{path}.{k}")
+            };
+            non_finite_key(x, &p)
+        }),
+        _ => None,
+    }
+}
+
+/// Refuse `nan` and `inf` anywhere in a parsed TOML document (every number the toolkit reads
+/// is finite), naming the key.
+pub fn reject_non_finite(file: &str, table: &toml::Table) -> Result<(), ConfigError> {
+    for (k, v) in table {
+        if let Some(key) = non_finite_key(v, k) {
+            return Err(ConfigError::Key {
+                source_name: file.into(),
+                key,
+                message: "expected a finite number, got nan or inf".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Read a TOML config file's text into a [`Layer`], accepting only `known` keys.
 ///
 /// Arrays become comma-separated text (for [`Settings::list`]). Unknown keys and malformed TOML
@@ -219,6 +254,7 @@ pub fn layer_from_toml(file: &str, text: &str, known: &[&str]) -> Result<Layer, 
             file: file.into(),
             message: e.to_string(),
         })?;
+    reject_non_finite(file, &table)?;
     let mut values = BTreeMap::new();
     for (k, v) in table {
         if !known.contains(&k.as_str()) {
