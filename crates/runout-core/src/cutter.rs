@@ -71,13 +71,7 @@ impl Cutter {
         flute_length_mm: f64,
         profile: RadiusProfile,
     ) -> Result<Self, ParamError> {
-        let d = crate::limits::positive_at_most(
-            "diameter_mm",
-            diameter_mm,
-            crate::limits::MAX_DIAMETER_MM,
-            "mm",
-            "MAX_DIAMETER_MM",
-        )?;
+        let d = crate::limits::diameter("diameter_mm", diameter_mm)?;
         crate::limits::teeth("teeth", pitch_rad.len())?;
         for (q, p) in pitch_rad.iter().enumerate() {
             if !(p.is_finite() && *p > 0.0) {

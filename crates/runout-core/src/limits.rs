@@ -11,13 +11,18 @@
 //! | samples per revolution | 1 ..= 100 000 | [`MAX_SAMPLES_PER_REV`] |
 //! | points per flute (grind) | ..= 1 000 000 | [`MAX_POINTS_PER_FLUTE`] |
 //! | revolutions | ..= 100 000 | [`MAX_REVOLUTIONS`] |
+//! | probe grid points (layers × angles) | ..= 1 000 000 | [`MAX_PROBE_POINTS`] |
+//! | Monte-Carlo draws | ..= 100 000 | [`MAX_DRAWS`] |
 //! | coordinates in files (mm) | \|x\| ≤ 100 000 | [`MAX_COORDINATE_MM`] |
-//! | cutter diameter (mm) | (0, 2 000] | [`MAX_DIAMETER_MM`] |
+//! | cutter, shank, edge diameter (mm) | [0.001, 2 000] | [`MIN_DIAMETER_MM`], [`MAX_DIAMETER_MM`] |
 //! | feed per tooth f_z (mm) | (0, 10] | [`MAX_FZ_MM`] |
 //! | feed rate (mm/min) | [0.001, 1 000 000] | [`MIN_FEED_MM_MIN`], [`MAX_FEED_MM_MIN`] |
-//! | depths a_p, a_e (mm) | (0, 1 000] | [`MAX_DEPTH_MM`] |
+//! | depths a_p, a_e (mm) | a_p in [0.001, 1 000], a_e in (0, D] | [`MIN_DEPTH_MM`], [`MAX_DEPTH_MM`] |
 //! | spindle speed (rpm) | (0, 1 000 000] | [`MAX_RPM`] |
 //! | runout ρ | < cutter radius R | [`runout_vs_radius`] |
+//! | cutting coefficients (N/mm², N/mm) | \|K\| ≤ 10⁶ | [`MAX_COEFFICIENT`] |
+//! | simulated revolutions | ≥ 1 (a peak per tooth) | [`MIN_SIMULATED_REVOLUTIONS`] |
+//! | any value given with a unit (flags, config keys) | \|x\| ≤ 10⁵ mm, 10⁸ µm, 10⁶ deg, 10⁶ rpm, 10⁶ N/mm², 10⁶ N/mm, 10⁴ GPa, 10⁹ N, 10⁷ s, 10⁹ Hz, 10⁶ µm/mm, 10¹⁵ plain | [`MAX_ABS_QUANTITY`] |
 //! | text line (bytes) | ≤ 1 MiB | [`MAX_LINE_BYTES`] |
 //! | header of a recording (bytes) | ≤ 1 MiB | [`MAX_HEADER_BYTES`] |
 //! | non-streaming table or config file (bytes) | ≤ 64 MiB | [`MAX_TABLE_BYTES`] |
@@ -46,10 +51,16 @@ pub const MAX_DISKS: usize = 10_000;
 pub const MAX_SAMPLES_PER_REV: usize = 100_000;
 /// Largest number of points per flute of a ground edge.
 pub const MAX_POINTS_PER_FLUTE: usize = 1_000_000;
+/// Largest probe grid (layers × angles) of a simulated probe.
+pub const MAX_PROBE_POINTS: usize = 1_000_000;
+/// Largest number of Monte-Carlo draws.
+pub const MAX_DRAWS: usize = 100_000;
 /// Largest number of spindle revolutions simulated or sampled.
 pub const MAX_REVOLUTIONS: f64 = 100_000.0;
 /// Largest |coordinate| (mm) in a toolpath, NC program or table (100 m).
 pub const MAX_COORDINATE_MM: f64 = 1.0e5;
+/// Smallest cutter, shank or edge diameter (mm): 1 µm.
+pub const MIN_DIAMETER_MM: f64 = 1.0e-3;
 /// Largest cutter diameter (mm).
 pub const MAX_DIAMETER_MM: f64 = 2_000.0;
 /// Largest feed per tooth f_z (mm).
@@ -60,8 +71,40 @@ pub const MIN_FEED_MM_MIN: f64 = 1.0e-3;
 pub const MAX_FEED_MM_MIN: f64 = 1.0e6;
 /// Largest depth of cut a_p or a_e (mm).
 pub const MAX_DEPTH_MM: f64 = 1_000.0;
+/// Smallest axial depth of cut a_p (mm): 1 µm.
+pub const MIN_DEPTH_MM: f64 = 1.0e-3;
 /// Largest spindle speed (rpm).
 pub const MAX_RPM: f64 = 1.0e6;
+/// Largest |cutting coefficient| (N/mm² shear, N/mm edge) given as an input.
+pub const MAX_COEFFICIENT: f64 = 1.0e6;
+/// Fewest revolutions of a force simulation: every tooth's peak needs one full revolution.
+pub const MIN_SIMULATED_REVOLUTIONS: f64 = 1.0;
+/// Largest |value| of a number given with a unit, per quantity (unit as written, value, limit
+/// name): a flag or key beyond it is refused, whatever its meaning, so no later product or
+/// power of it overflows.
+pub const MAX_ABS_QUANTITY: &[(&str, f64)] = &[
+    ("mm", MAX_COORDINATE_MM),
+    ("µm", MAX_COORDINATE_MM * 1e3),
+    ("deg", 1.0e6),
+    ("rpm", MAX_RPM),
+    ("N/mm²", MAX_COEFFICIENT),
+    ("N/mm", MAX_COEFFICIENT),
+    ("GPa", 1.0e4),
+    ("N", 1.0e9),
+    ("s", 1.0e7),
+    ("Hz", 1.0e9),
+    ("µm/mm", 1.0e6),
+    ("", 1.0e15),
+];
+
+/// The [`MAX_ABS_QUANTITY`] of the quantity written in `unit` (`""` for plain numbers).
+pub fn max_abs_quantity(unit: &str) -> f64 {
+    MAX_ABS_QUANTITY
+        .iter()
+        .find(|(u, _)| *u == unit)
+        .map_or(1.0e15, |(_, m)| *m)
+}
+
 /// Longest line of a text file (bytes).
 pub const MAX_LINE_BYTES: usize = 1024 * 1024;
 /// Largest header of a recording (bytes before the first data row).
@@ -87,6 +130,18 @@ pub fn count(key: &str, value: usize, max: usize, limit: &str) -> Result<usize, 
             value,
         ))
     }
+}
+
+/// A diameter (mm) in [[`MIN_DIAMETER_MM`], [`MAX_DIAMETER_MM`]].
+pub fn diameter(key: &str, value: f64) -> Result<f64, ParamError> {
+    within(
+        key,
+        value,
+        MIN_DIAMETER_MM,
+        MAX_DIAMETER_MM,
+        "mm",
+        "MIN_DIAMETER_MM/MAX_DIAMETER_MM",
+    )
 }
 
 /// Number of teeth K, checked before anything is allocated per tooth.

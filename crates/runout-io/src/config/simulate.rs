@@ -262,6 +262,26 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
         .and_then(|r| limits::runout_vs_radius("runout_um", rho, cutter.radius()).map(|_| r))
         .map_err(|e| key_err(s, e))?;
 
+    for (k, q) in [
+        ("ktc", Quantity::ForcePerArea),
+        ("krc", Quantity::ForcePerArea),
+        ("kac", Quantity::ForcePerArea),
+        ("kte", Quantity::ForcePerLength),
+        ("kre", Quantity::ForcePerLength),
+        ("kae", Quantity::ForcePerLength),
+    ] {
+        if let Some(v) = s.quantity(k, q)? {
+            limits::within(
+                k,
+                v,
+                -limits::MAX_COEFFICIENT,
+                limits::MAX_COEFFICIENT,
+                "N/mm² (shear) or N/mm (edge)",
+                "MAX_COEFFICIENT",
+            )
+            .map_err(|e| key_err(s, e))?;
+        }
+    }
     let coefficients = CuttingCoefficients::new(
         [
             s.require("ktc", Quantity::ForcePerArea, "K_tc")?,
@@ -281,7 +301,19 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
     let disks = s
         .count("disks")?
         .unwrap_or(if helix == 0.0 { 1 } else { 50 });
-    let sampling = Sampling::new(revolutions, step, disks).map_err(|e| key_err(s, e))?;
+    let sampling = Sampling::new(revolutions, step, disks)
+        .and_then(|sm| {
+            limits::within(
+                "revolutions",
+                revolutions,
+                limits::MIN_SIMULATED_REVOLUTIONS,
+                limits::MAX_REVOLUTIONS,
+                "(every tooth's peak needs a full revolution)",
+                "MIN_SIMULATED_REVOLUTIONS",
+            )
+            .map(|_| sm)
+        })
+        .map_err(|e| key_err(s, e))?;
     let chip_model = s.text("chip_model")?.unwrap_or_else(|| "arc".into());
     if !CHIP_MODELS.contains(&chip_model.as_str()) {
         return Err(ConfigError::Key {
