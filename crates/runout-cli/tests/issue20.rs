@@ -211,7 +211,21 @@ fn row06_identify_ap_1e308_is_a_range_error() {
             "--ap-mm",
             "1e308",
         ],
-        &["ap_mm", "MAX_DEPTH_MM", "1e308"],
+        &["ap_mm", "out of range", "1e308", "MAX_ABS_QUANTITY"],
+        &[&a, &b, &c],
+    );
+    // within the range of lengths, beyond the range of depths
+    refused(
+        &[
+            "identify",
+            s(&a),
+            s(&b),
+            "--config",
+            s(&c),
+            "--ap-mm",
+            "5000",
+        ],
+        &["ap_mm", "MAX_DEPTH_MM", "5000"],
         &[&a, &b, &c],
     );
 }
@@ -229,7 +243,12 @@ fn row07_identify_fz_1e308_is_a_range_error_not_a_hang() {
             "--fz-mm",
             "1e308",
         ],
-        &["fz_mm", "MAX_FZ_MM", "1e308"],
+        &["fz_mm", "out of range", "1e308", "MAX_ABS_QUANTITY"],
+        &[&a, &b, &c],
+    );
+    refused(
+        &["identify", s(&a), s(&b), "--config", s(&c), "--fz-mm", "50"],
+        &["fz_mm", "MAX_FZ_MM", "50"],
         &[&a, &b, &c],
     );
 }
@@ -659,5 +678,22 @@ fn non_finite_numbers_anywhere_in_a_parsed_file_are_errors() {
         ],
         &["shank.modulus_gpa", "finite"],
         &[&shank],
+    );
+}
+
+#[test]
+fn endless_recording_header_is_refused_at_the_header_limit() {
+    let d = tempfile::tempdir().unwrap();
+    let rec = d.path().join("endless.txt");
+    let mut text = String::from("DynoWare,Version 2.5.1.2\n");
+    while text.len() < 2 * 1024 * 1024 {
+        text += "Comment:,a long comment line that never ends the header\n";
+    }
+    std::fs::write(&rec, text).unwrap();
+    let cfg = example("identify/cut.toml");
+    refused(
+        &["identify", s(&rec), "--config", s(&cfg), "--fz-mm", "0.05"],
+        &["endless.txt", "MAX_HEADER_BYTES"],
+        &[&rec],
     );
 }

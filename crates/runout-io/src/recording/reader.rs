@@ -702,6 +702,16 @@ fn read_dynoware_header<R: BufRead>(
                 "DynoWare header ended before the channel-name row (e.g. `Time,Fx,Fy,Fz`)".into(),
             ));
         };
+        if lines.bytes > runout_core::limits::MAX_HEADER_BYTES as u64 {
+            return Err(header_err(
+                n,
+                format!(
+                    "DynoWare header longer than {} bytes without a channel-name row (limit \
+                     MAX_HEADER_BYTES)",
+                    runout_core::limits::MAX_HEADER_BYTES
+                ),
+            ));
+        }
         let s = decode(buf);
         match key_line(&s, delimiter as char) {
             Some(kv) => metadata.push(kv),
