@@ -74,6 +74,14 @@ fn main() -> ExitCode {
         Command::Grind(a) => cmd::grind::run(a),
         Command::Shank(a) => cmd::shank::run(a),
     };
+    // outputs appear only when the whole command succeeded
+    let result = match result {
+        Ok(()) => output::commit_all(),
+        Err(e) => {
+            output::discard_all();
+            Err(e)
+        }
+    };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,

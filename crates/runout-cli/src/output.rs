@@ -1,11 +1,49 @@
 //! Writing results: never onto one of the user's inputs (compared by file identity, not by
-//! name), never half-written (a temporary file in the same folder, renamed at the end), and `-`
-//! means standard output.
+//! name), never half-written (each file goes to a temporary file in the same folder; all of them
+//! are renamed onto their destinations by [`commit_all`] when the command has succeeded, and
+//! removed by [`discard_all`] when it failed), and `-` means standard output.
 
 use anyhow::{bail, Context, Result};
 use std::fs::File;
 use std::io::{self, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Finished temporary files waiting for the command's outcome: (temporary, destination).
+static PENDING: Mutex<Vec<(PathBuf, PathBuf)>> = Mutex::new(Vec::new());
+
+fn pending() -> std::sync::MutexGuard<'static, Vec<(PathBuf, PathBuf)>> {
+    PENDING.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Write errors noticed where they could not be returned (a writer dropped unfinished).
+static LATE_ERRORS: Mutex<Vec<String>> = Mutex::new(Vec::new());
+
+/// The command succeeded: rename every finished temporary file onto its destination (or, if a
+/// dropped writer failed, remove them all and report it).
+pub fn commit_all() -> Result<()> {
+    let late = std::mem::take(&mut *LATE_ERRORS.lock().unwrap_or_else(|e| e.into_inner()));
+    if let Some(e) = late.into_iter().next() {
+        discard_all();
+        bail!("{e}");
+    }
+    let files = std::mem::take(&mut *pending());
+    let mut first_err = None;
+    for (tmp, dest) in files {
+        if let Err(e) = std::fs::rename(&tmp, &dest) {
+            let _ = std::fs::remove_file(&tmp);
+            first_err.get_or_insert(anyhow::anyhow!("writing {}: {e}", dest.display()));
+        }
+    }
+    first_err.map_or(Ok(()), Err)
+}
+
+/// The command failed: remove every temporary file, leaving the destinations as they were.
+pub fn discard_all() {
+    for (tmp, _) in std::mem::take(&mut *pending()) {
+        let _ = std::fs::remove_file(&tmp);
+    }
+}
 
 /// Identity of an existing file: device and inode on Unix, the canonical path elsewhere (or
 /// where the metadata cannot be read).
@@ -110,9 +148,9 @@ pub fn check_distinct(inputs: &[PathBuf], what: &str) -> Result<()> {
     Ok(())
 }
 
-/// A file being written: bytes go to a temporary file next to `dest`, which is renamed onto
-/// `dest` when the writer is finished or dropped without an earlier write error. After a write
-/// error the temporary file is removed and `dest` is left as it was.
+/// A file being written: bytes go to a temporary file next to `dest`. Finished (or dropped
+/// without a write error), it waits for [`commit_all`]; after a write error it is removed and
+/// `dest` is left as it was.
 pub struct AtomicFile {
     inner: Option<BufWriter<File>>,
     tmp: PathBuf,
@@ -143,7 +181,7 @@ impl AtomicFile {
         })
     }
 
-    /// Flush and rename onto the destination.
+    /// Flush; the file is renamed onto its destination by [`commit_all`].
     pub fn finish(mut self) -> Result<()> {
         self.commit()
             .with_context(|| format!("writing {}", self.dest.display()))
@@ -153,11 +191,13 @@ impl AtomicFile {
         let Some(mut w) = self.inner.take() else {
             return Ok(());
         };
-        let done = w
-            .flush()
-            .and_then(|_| std::fs::rename(&self.tmp, &self.dest));
-        if done.is_err() {
-            let _ = std::fs::remove_file(&self.tmp);
+        let done = w.flush();
+        drop(w);
+        match &done {
+            Ok(()) => pending().push((self.tmp.clone(), self.dest.clone())),
+            Err(_) => {
+                let _ = std::fs::remove_file(&self.tmp);
+            }
         }
         done
     }
@@ -196,7 +236,10 @@ impl Drop for AtomicFile {
             self.inner.take();
             let _ = std::fs::remove_file(&self.tmp);
         } else if let Err(e) = self.commit() {
-            eprintln!("error: writing {}: {e}", self.dest.display());
+            LATE_ERRORS
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(format!("writing {}: {e}", self.dest.display()));
         }
     }
 }
@@ -257,6 +300,7 @@ mod tests {
         let other = dir.path().join("out.nc");
         assert!(check_not_input(&other, &[&a]).is_ok());
         write_text(&other, "G1 X2\n").unwrap();
+        commit_all().unwrap();
         assert_eq!(std::fs::read_to_string(&other).unwrap(), "G1 X2\n");
         let copy = dir.path().join("copy.nc");
         std::fs::write(&copy, "G1 X1\n").unwrap();
@@ -266,6 +310,9 @@ mod tests {
             let mut w = create(&dir.path().join("w.csv")).unwrap();
             writeln!(w, "a,b").unwrap();
         }
+        // not there before the command's outcome is known
+        assert!(!dir.path().join("w.csv").exists());
+        commit_all().unwrap();
         assert_eq!(
             std::fs::read_to_string(dir.path().join("w.csv")).unwrap(),
             "a,b\n"

@@ -697,3 +697,39 @@ fn endless_recording_header_is_refused_at_the_header_limit() {
         &[&rec],
     );
 }
+
+// ----------------------------------------------------------------------------------------------
+// item 3: outputs are renamed into place only when the whole command succeeded
+
+#[test]
+fn a_command_failing_after_writing_leaves_no_output_and_no_temporary_file() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("forces.csv");
+    let old = d.path().join("old.csv");
+    std::fs::write(&old, "previous contents\n").unwrap();
+    // the CSV is written before `--recording` is found to lack `--sample-rate-hz`
+    let a = simulate_with(&[
+        "--teeth",
+        "4",
+        "--out",
+        s(&out),
+        "--json",
+        s(&old),
+        "--recording",
+        s(&d.path().join("rec.txt")),
+    ]);
+    refused(&strs(&a), &["--sample-rate-hz"], &[&old]);
+    assert!(!out.exists());
+    let names: Vec<String> = std::fs::read_dir(d.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["old.csv"], "{names:?}");
+    // and a successful run writes both
+    let a = simulate_with(&["--teeth", "4", "--out", s(&out), "--json", s(&old)]);
+    assert!(run(&strs(&a)).0.status.success());
+    assert!(std::fs::read_to_string(&out)
+        .unwrap()
+        .starts_with("time_s,"));
+    assert!(std::fs::read_to_string(&old).unwrap().starts_with('{'));
+}
