@@ -37,24 +37,32 @@ enum Command {
     Shank(cmd::shank::Args),
 }
 
-/// Writing to a closed pipe (`runout … | head -1`) ends the program quietly, as for other Unix
-/// tools (status 141, SIGPIPE), instead of a panic in `println!`. Rust starts programs with
-/// SIGPIPE ignored; this restores the default action.
-#[cfg(unix)]
-fn default_sigpipe() {
-    const SIGPIPE: i32 = 13;
-    const SIG_DFL: usize = 0;
-    extern "C" {
-        fn signal(signum: i32, handler: usize) -> usize;
-    }
-    // SAFETY: called first thing in main, before any other thread exists; SIG_DFL is a valid
-    // disposition for SIGPIPE.
-    unsafe {
-        signal(SIGPIPE, SIG_DFL);
-    }
+/// Status of a command whose standard output was closed early (`runout … | head -1`), as a
+/// shell reports a program ended by SIGPIPE.
+const BROKEN_PIPE_STATUS: u8 = 141;
+
+/// A closed standard output ends the program quietly: the files finished so far are complete and
+/// are kept ([`output::commit_all`]), nothing more is written, status 141. `println!` reports a
+/// closed pipe by panicking; this hook turns that panic into the quiet end (every other panic
+/// keeps the default report).
+fn quiet_on_broken_pipe() {
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let p = info.payload();
+        let msg = p
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| p.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.starts_with("failed printing to stdout") && msg.contains("Broken pipe") {
+            let _ = output::commit_all();
+            std::process::exit(i32::from(BROKEN_PIPE_STATUS));
+        }
+        default_hook(info);
+    }));
 }
 
-/// True if the error is a write to a closed pipe (ends quietly, status 0).
+/// True if the error is a write to a closed pipe (ends quietly).
 fn is_broken_pipe(e: &anyhow::Error) -> bool {
     e.chain().any(|c| {
         c.downcast_ref::<std::io::Error>()
@@ -63,8 +71,7 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
 }
 
 fn main() -> ExitCode {
-    #[cfg(unix)]
-    default_sigpipe();
+    quiet_on_broken_pipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
@@ -74,9 +81,13 @@ fn main() -> ExitCode {
         Command::Grind(a) => cmd::grind::run(a),
         Command::Shank(a) => cmd::shank::run(a),
     };
-    // outputs appear only when the whole command succeeded
+    // outputs appear only when the whole command succeeded (or only its stdout was cut short)
     let result = match result {
         Ok(()) => output::commit_all(),
+        Err(e) if is_broken_pipe(&e) => {
+            let _ = output::commit_all();
+            return ExitCode::from(BROKEN_PIPE_STATUS);
+        }
         Err(e) => {
             output::discard_all();
             Err(e)
@@ -84,7 +95,6 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(1)
