@@ -733,3 +733,28 @@ fn a_command_failing_after_writing_leaves_no_output_and_no_temporary_file() {
         .starts_with("time_s,"));
     assert!(std::fs::read_to_string(&old).unwrap().starts_with('{'));
 }
+
+#[test]
+fn toml_errors_on_long_lines_do_not_echo_the_line() {
+    let d = tempfile::tempdir().unwrap();
+    let cfg = d.path().join("long.toml");
+    std::fs::write(&cfg, format!("teeth = 4\n{}\n", "x".repeat(500_000))).unwrap();
+    for cmd in [&["simulate"][..], &["chip", "eval"][..]] {
+        let mut a = cmd.to_vec();
+        a.push(s(&cfg));
+        let err = refused(&a, &["long.toml", "line 2"], &[&cfg]);
+        assert!(err.len() < 300, "{}", &err[..err.len().min(300)]);
+    }
+    let long_value = d.path().join("value.toml");
+    std::fs::write(
+        &long_value,
+        format!("[[case]]\nname = \"a\"\nteeth = \"{}\"\n", "y".repeat(5000)),
+    )
+    .unwrap();
+    let err = refused(
+        &["chip", "eval", s(&long_value)],
+        &["case 1"],
+        &[&long_value],
+    );
+    assert!(err.len() < 600, "{}", &err[..err.len().min(600)]);
+}

@@ -153,7 +153,7 @@ pub fn parse_toml(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
             file: file.into(),
             line,
             column: None,
-            message: e.message().to_string(),
+            message: crate::config::clip_quoted(e.message()),
         }
     })?;
     let mut rows = t.test;

@@ -185,7 +185,8 @@ pub fn parse_case_specs(file: &str, text: &str) -> Result<Vec<ChipCaseSpec>, Chi
         file: file.into(),
         message,
     };
-    let mut doc: toml::Table = toml::from_str(text).map_err(|e| perr(e.to_string()))?;
+    let mut doc: toml::Table =
+        toml::from_str(text).map_err(|e| perr(super::toml_error(text, &e)))?;
     if let Some(key) = doc.iter().find_map(|(k, v)| super::non_finite_key(v, k)) {
         return Err(perr(format!(
             "key `{key}`: expected a finite number, got nan or inf"
@@ -216,7 +217,13 @@ pub fn parse_case_specs(file: &str, text: &str) -> Result<Vec<ChipCaseSpec>, Chi
             merged.extend(t);
             toml::Value::Table(merged)
                 .try_into::<ChipCaseSpec>()
-                .map_err(|e| perr(format!("case {}: {e}", n + 1)))
+                .map_err(|e| {
+                    perr(format!(
+                        "case {}: {}",
+                        n + 1,
+                        super::clip_quoted(e.message())
+                    ))
+                })
         })
         .collect()
 }

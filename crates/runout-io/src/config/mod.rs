@@ -200,6 +200,44 @@ impl Settings {
     }
 }
 
+/// A TOML error as `line L, column C: message`, without the source snippet the parser's own
+/// display adds (which would echo a whole long line) and with every `quoted` part of the
+/// message clipped to 80 characters.
+pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
+    let msg = clip_quoted(e.message().trim());
+    match e.span().and_then(|s| text.get(..s.start)) {
+        Some(before) => {
+            let line = before.matches('\n').count() + 1;
+            let col = before[before.rfind('\n').map_or(0, |i| i + 1)..]
+                .chars()
+                .count()
+                + 1;
+            format!("TOML parse error at line {line}, column {col}: {msg}")
+        }
+        None => format!("TOML parse error: {msg}"),
+    }
+}
+
+/// Clip each `…`-quoted part of a message to 80 characters, and the whole to 400.
+pub fn clip_quoted(msg: &str) -> String {
+    let clipped = msg
+        .split('`')
+        .enumerate()
+        .map(|(i, p)| {
+            if i % 2 == 1 {
+                crate::textfile::quote(p)
+            } else {
+                p.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("`");
+    match clipped.char_indices().nth(400) {
+        Some((i, _)) => format!("{}…", &clipped[..i]),
+        None => clipped,
+    }
+}
+
 /// The key path of the first non-finite float (`nan`, `inf`) anywhere in a TOML value.
 pub(crate) fn non_finite_key(v: &toml::Value, path: &str) -> Option<String> {
     match v {
@@ -252,7 +290,7 @@ pub fn layer_from_toml(file: &str, text: &str, known: &[&str]) -> Result<Layer, 
         .parse()
         .map_err(|e: toml::de::Error| ConfigError::Parse {
             file: file.into(),
-            message: e.to_string(),
+            message: toml_error(text, &e),
         })?;
     reject_non_finite(file, &table)?;
     let mut values = BTreeMap::new();

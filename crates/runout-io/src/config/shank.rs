@@ -177,7 +177,7 @@ impl ShankConfig {
         }
         toml::from_str(text).map_err(|e| ConfigError::Parse {
             file: file.into(),
-            message: e.to_string(),
+            message: super::toml_error(text, &e),
         })
     }
 }
