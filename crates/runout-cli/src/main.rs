@@ -37,7 +37,41 @@ enum Command {
     Shank(cmd::shank::Args),
 }
 
+/// Status of a command whose standard output was closed early (`runout … | head -1`), as a
+/// shell reports a program ended by SIGPIPE.
+const BROKEN_PIPE_STATUS: u8 = 141;
+
+/// A closed standard output ends the program quietly: the files finished so far are complete and
+/// are kept ([`output::commit_all`]), nothing more is written, status 141. `println!` reports a
+/// closed pipe by panicking; this hook turns that panic into the quiet end (every other panic
+/// keeps the default report).
+fn quiet_on_broken_pipe() {
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let p = info.payload();
+        let msg = p
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| p.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.starts_with("failed printing to stdout") && msg.contains("Broken pipe") {
+            let _ = output::commit_all();
+            std::process::exit(i32::from(BROKEN_PIPE_STATUS));
+        }
+        default_hook(info);
+    }));
+}
+
+/// True if the error is a write to a closed pipe (ends quietly).
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}
+
 fn main() -> ExitCode {
+    quiet_on_broken_pipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
@@ -46,6 +80,18 @@ fn main() -> ExitCode {
         Command::Chip(a) => cmd::chip::run(a),
         Command::Grind(a) => cmd::grind::run(a),
         Command::Shank(a) => cmd::shank::run(a),
+    };
+    // outputs appear only when the whole command succeeded (or only its stdout was cut short)
+    let result = match result {
+        Ok(()) => output::commit_all(),
+        Err(e) if is_broken_pipe(&e) => {
+            let _ = output::commit_all();
+            return ExitCode::from(BROKEN_PIPE_STATUS);
+        }
+        Err(e) => {
+            output::discard_all();
+            Err(e)
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

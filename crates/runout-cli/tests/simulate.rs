@@ -103,16 +103,17 @@ const GOOD: &str = "teeth = 4\ndiameter_mm = 10\nrpm = 3000\nfz_mm = 0.1\nap_mm 
 #[test]
 fn bad_configs_name_the_key_and_what_was_expected() {
     assert!(with_config(GOOD).0);
-    let cases: [(&str, &str, &str); 11] = [
+    let cases: [(&str, &str, &str); 12] = [
         (
             "ap_mm = 1",
             "ap_mm = 1\nflute_length_mm = 0.5",
             "flute length",
         ),
+        ("revolutions = 1", "revolutions = 1e9", "MAX_REVOLUTIONS"),
         (
-            "revolutions = 1",
-            "revolutions = 1e9",
-            "at most 100000000 samples",
+            "step_deg = 1",
+            "step_deg = 0.00001",
+            "at most 20000000 samples",
         ),
         ("diameter_mm = 10", "diameter_mm = -10", "diameter_mm"),
         ("diameter_mm = 10", "diameter_mm = 0", "diameter_mm"),

@@ -73,9 +73,19 @@ impl Cut {
     /// Spindle speed (rpm), feed per tooth f_z (mm) and axial depth a_p (mm); slotting until
     /// [`Cut::radial`] or [`Cut::angles`] says otherwise.
     pub fn new(rpm: f64, fz_mm: f64, ap_mm: f64) -> Result<Self, ParamError> {
-        positive("rpm", rpm)?;
-        positive("fz_mm", fz_mm)?;
-        positive("ap_mm", ap_mm)?;
+        use crate::limits::{
+            positive_at_most, within, MAX_DEPTH_MM, MAX_FZ_MM, MAX_RPM, MIN_DEPTH_MM,
+        };
+        positive_at_most("rpm", rpm, MAX_RPM, "rpm", "MAX_RPM")?;
+        positive_at_most("fz_mm", fz_mm, MAX_FZ_MM, "mm", "MAX_FZ_MM")?;
+        within(
+            "ap_mm",
+            ap_mm,
+            MIN_DEPTH_MM,
+            MAX_DEPTH_MM,
+            "mm",
+            "MIN_DEPTH_MM/MAX_DEPTH_MM",
+        )?;
         Ok(Cut {
             rpm,
             fz: fz_mm,

@@ -4,7 +4,7 @@
 //! order; tooth i sits at spindle-frame angle ψ_i = −Σ_{q<i} pitch_q at the tool tip (z = 0),
 //! so uniform pitch gives ψ_i = −2πi/K; a right-hand helix lags by z·tan β / R.
 
-use crate::error::{finite, positive, ParamError};
+use crate::error::{finite, ParamError};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 
@@ -51,9 +51,7 @@ pub struct Cutter {
 impl Cutter {
     /// Flat end mill with uniform pitch; `helix_deg` is the helix angle (0 for straight flutes).
     pub fn flat(diameter_mm: f64, teeth: usize, helix_deg: f64) -> Result<Self, ParamError> {
-        if teeth == 0 {
-            return Err(ParamError::new("teeth", "an integer >= 1", teeth));
-        }
+        crate::limits::teeth("teeth", teeth)?;
         let pitch = vec![TAU / teeth as f64; teeth];
         Self::new(
             diameter_mm,
@@ -73,10 +71,8 @@ impl Cutter {
         flute_length_mm: f64,
         profile: RadiusProfile,
     ) -> Result<Self, ParamError> {
-        let d = positive("diameter_mm", diameter_mm)?;
-        if pitch_rad.is_empty() {
-            return Err(ParamError::new("teeth", "an integer >= 1", 0));
-        }
+        let d = crate::limits::diameter("diameter_mm", diameter_mm)?;
+        crate::limits::teeth("teeth", pitch_rad.len())?;
         for (q, p) in pitch_rad.iter().enumerate() {
             if !(p.is_finite() && *p > 0.0) {
                 return Err(ParamError::new(

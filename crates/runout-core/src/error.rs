@@ -36,7 +36,11 @@ pub(crate) fn positive(param: &str, value: f64) -> Result<f64, ParamError> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(ParamError::new(param, "a finite number > 0", value))
+        Err(ParamError::new(
+            param,
+            "a finite number > 0",
+            crate::limits::show(value),
+        ))
     }
 }
 
@@ -45,7 +49,11 @@ pub(crate) fn non_negative(param: &str, value: f64) -> Result<f64, ParamError> {
     if value.is_finite() && value >= 0.0 {
         Ok(value)
     } else {
-        Err(ParamError::new(param, "a finite number >= 0", value))
+        Err(ParamError::new(
+            param,
+            "a finite number >= 0",
+            crate::limits::show(value),
+        ))
     }
 }
 
@@ -54,6 +62,10 @@ pub(crate) fn finite(param: &str, value: f64) -> Result<f64, ParamError> {
     if value.is_finite() {
         Ok(value)
     } else {
-        Err(ParamError::new(param, "a finite number", value))
+        Err(ParamError::new(
+            param,
+            "a finite number",
+            crate::limits::show(value),
+        ))
     }
 }

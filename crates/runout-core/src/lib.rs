@@ -29,6 +29,7 @@ pub mod error;
 pub mod force;
 pub mod grind;
 pub mod identify;
+pub mod limits;
 pub mod runout;
 pub mod shank;
 pub mod signal;

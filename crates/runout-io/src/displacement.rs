@@ -120,6 +120,18 @@ fn next_record(
 
 /// A whole (small) table in memory.
 fn read_table(path: &Path) -> Result<Table, TableError> {
+    let max = runout_core::limits::MAX_TABLE_BYTES;
+    if let Ok(m) = std::fs::metadata(path) {
+        if m.is_file() && m.len() > max {
+            return Err(TableError::File {
+                file: path.display().to_string(),
+                message: format!(
+                    "{} bytes: larger than the {max} bytes a table may have (limit MAX_TABLE_BYTES)",
+                    m.len()
+                ),
+            });
+        }
+    }
     let (mut t, mut rdr) = open_table(path)?;
     let mut records = rdr.records();
     while let Some(row) = next_record(&t, &mut records)? {
@@ -191,11 +203,16 @@ impl Table {
     /// Cell `col` of record `rec` (at `line`) as a finite number times the column's unit factor.
     fn cell(&self, line: u64, rec: &csv::StringRecord, col: &Column) -> Result<f64, TableError> {
         let text = rec.get(col.index).unwrap_or("");
+        let quoted = || crate::textfile::quote(text);
         let v: f64 = text
             .parse()
-            .map_err(|_| self.cell_error(line, col, format!("`{text}` is not a number")))?;
-        if !v.is_finite() {
-            return Err(self.cell_error(line, col, format!("`{text}` is not a finite number")));
+            .map_err(|_| self.cell_error(line, col, format!("`{}` is not a number", quoted())))?;
+        if !(v * col.factor).is_finite() {
+            return Err(self.cell_error(
+                line,
+                col,
+                format!("`{}` is not a finite number", quoted()),
+            ));
         }
         Ok(v * col.factor)
     }

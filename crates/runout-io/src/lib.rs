@@ -16,5 +16,6 @@ pub mod lineplot;
 pub mod peak_table;
 pub mod plot;
 pub mod recording;
+pub mod textfile;
 pub mod toolpath;
 pub mod units;

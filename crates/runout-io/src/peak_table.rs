@@ -16,7 +16,7 @@ use std::path::Path;
 
 /// Error naming the file, line (and column) and what was expected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}:{line}{}: {message}", column.map(|c| format!(":{c}")).unwrap_or_default())]
+#[error("{file}{}{}: {message}", if *line > 0 { format!(":{line}") } else { String::new() }, column.map(|c| format!(":{c}")).unwrap_or_default())]
 pub struct PeakTableError {
     /// The file.
     pub file: String,
@@ -101,11 +101,11 @@ struct TomlTable {
 /// Read a peak table; the format follows the extension (`.toml`, else CSV/TSV).
 pub fn read_peak_table(path: &Path) -> Result<PeakTable, PeakTableError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| PeakTableError {
+    let text = crate::textfile::read_text(path).map_err(|e| PeakTableError {
         file: file.clone(),
-        line: 0,
+        line: e.line.unwrap_or(0),
         column: None,
-        message: format!("cannot read: {e}"),
+        message: e.message,
     })?;
     let is_toml = path
         .extension()
@@ -119,6 +119,19 @@ pub fn read_peak_table(path: &Path) -> Result<PeakTable, PeakTableError> {
 
 /// Parse a TOML peak table.
 pub fn parse_toml(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
+    if let Ok(doc) = text.parse::<toml::Table>() {
+        if let Some(key) = doc
+            .iter()
+            .find_map(|(k, v)| crate::config::non_finite_key(v, k))
+        {
+            return Err(PeakTableError {
+                file: file.into(),
+                line: 0,
+                column: None,
+                message: format!("key `{key}`: expected a finite number, got nan or inf"),
+            });
+        }
+    }
     let t: TomlTable = toml::from_str(text).map_err(|e: toml::de::Error| {
         let mut line = e
             .span()
@@ -140,7 +153,7 @@ pub fn parse_toml(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
             file: file.into(),
             line,
             column: None,
-            message: e.message().to_string(),
+            message: crate::config::clip_quoted(e.message()),
         }
     })?;
     let mut rows = t.test;
@@ -243,7 +256,11 @@ pub fn parse_csv(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
                 err(
                     line,
                     Some(c + 1),
-                    format!("`{t}` in column `{}` is not a number", &headers[c]),
+                    format!(
+                        "`{}` in column `{}` is not a number",
+                        crate::textfile::quote(t),
+                        &headers[c]
+                    ),
                 )
             })?;
             if v.is_finite() {
@@ -252,7 +269,11 @@ pub fn parse_csv(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
                 Err(err(
                     line,
                     Some(c + 1),
-                    format!("`{t}` in column `{}` is not finite", &headers[c]),
+                    format!(
+                        "`{}` in column `{}` is not finite",
+                        crate::textfile::quote(t),
+                        &headers[c]
+                    ),
                 ))
             }
         };

@@ -71,9 +71,16 @@ pub enum ToolpathError {
 /// Read a toolpath; CSV when the extension is `.csv`, APT CL otherwise.
 pub fn read_toolpath(path: &Path) -> Result<Toolpath, ToolpathError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| ToolpathError::Io {
-        file: name.clone(),
-        source,
+    let text = crate::textfile::read_text(path).map_err(|e| match e.line {
+        Some(line) => ToolpathError::Parse {
+            file: name.clone(),
+            line,
+            message: e.message,
+        },
+        None => ToolpathError::Path {
+            file: name.clone(),
+            message: e.message,
+        },
     })?;
     let is_csv = path
         .extension()
@@ -110,6 +117,20 @@ fn unit_axis(
         ));
     }
     Ok([v[0] / n, v[1] / n, v[2] / n])
+}
+
+/// Tool tip coordinates within [`runout_core::limits::MAX_COORDINATE_MM`].
+fn check_point(file: &str, line: usize, p: &[f64; 3]) -> Result<(), ToolpathError> {
+    for (a, v) in ["x", "y", "z"].iter().zip(p) {
+        runout_core::limits::coordinate(&format!("{a}_mm"), *v).map_err(|e| {
+            ToolpathError::Parse {
+                file: file.into(),
+                line,
+                message: format!("coordinate out of range: {e}"),
+            }
+        })?;
+    }
+    Ok(())
 }
 
 /// One logical APT statement with the line it starts on.
@@ -150,6 +171,71 @@ fn apt_statements(text: &str) -> Vec<Statement> {
         out.push(s);
     }
     out
+}
+
+/// APT statements that do not move the tool or set the feed: ignored without a warning.
+const IGNORED_APT: &[&str] = &[
+    "PARTNO",
+    "CUTTER",
+    "SPINDL",
+    "LOADTL",
+    "COOLNT",
+    "FINI",
+    "PPRINT",
+    "INSERT",
+    "REMARK",
+    "TLAXIS",
+    "INTOL",
+    "OUTTOL",
+    "TOLER",
+    "CLRSRF",
+    "END",
+    "STOP",
+    "OPSTOP",
+    "SELCTL",
+    "TLON",
+    "TLOFF",
+    "SET",
+    "MACHIN",
+    "PPFUN",
+    "TITLE",
+    "CUTCOM",
+    "ORIGIN",
+    "DELAY",
+    "AUXFUN",
+    "PREFUN",
+    "CLEARP",
+    "RETRCT",
+    "SEQNO",
+    "NOPOST",
+    "TRANS",
+    "OPERATION",
+    "OPNAME",
+    "TOOL",
+    "PIVOTZ",
+    "DISPLY",
+    "LINTOL",
+    "HEAD",
+    "MODE",
+    "THICK",
+    "CYCLE",
+    "DRAFT",
+    "FROM",
+    "END-OF-PATH",
+    "TPRINT",
+    "GOHOME",
+    "MSYS",
+    "RESET",
+    "ROTABL",
+    "ROTATE",
+];
+
+/// At most 80 characters of `text` for a message.
+fn clip(text: &str) -> String {
+    match text.char_indices().nth(80) {
+        Some((i, _)) => format!("{}…", &text[..i]),
+        None => text.to_string(),
+    }
 }
 
 /// APT parser state.
@@ -204,7 +290,29 @@ impl Apt<'_> {
                 st.line,
                 format!("{word}: circular moves are not supported; export linearised GOTO points"),
             )),
-            _ => Ok(()),
+            w if IGNORED_APT.contains(&w) => Ok(()),
+            w if !w.starts_with(|c: char| c.is_ascii_alphabetic())
+                || !w
+                    .chars()
+                    .all(|c| c.is_ascii_alphabetic() || c == '_' || c == '-') =>
+            {
+                Err(self.err(
+                    st.line,
+                    format!(
+                        "unknown APT record `{}` (not a word; expected GOTO, FEDRAT, RAPID, MULTAX, UNITS or another APT statement)",
+                        clip(&st.text)
+                    ),
+                ))
+            }
+            w => {
+                self.path.warnings.push(format!(
+                    "{}:{}: unknown APT record `{}` ignored",
+                    self.file,
+                    st.line,
+                    clip(w)
+                ));
+                Ok(())
+            }
         }
     }
 
@@ -239,10 +347,9 @@ impl Apt<'_> {
             }
         }
         let v = value.ok_or_else(|| self.err(line, "FEDRAT: expected a feed value"))?;
-        if !(v.is_finite() && v > 0.0) {
-            return Err(self.err(line, format!("FEDRAT: expected a feed > 0, got {v}")));
-        }
-        self.feed = Some(v * per_min_scale);
+        let v = runout_core::limits::feed_mm_min("FEDRAT", v * per_min_scale)
+            .map_err(|e| self.err(line, e.to_string()))?;
+        self.feed = Some(v);
         self.rapid = false;
         Ok(())
     }
@@ -266,8 +373,10 @@ impl Apt<'_> {
             }
         };
         let axis = unit_axis(self.file, line, axis, &mut self.path.warnings)?;
+        let p = [v[0] * self.scale, v[1] * self.scale, v[2] * self.scale];
+        check_point(self.file, line, &p)?;
         self.path.points.push(ToolpathPoint {
-            p: [v[0] * self.scale, v[1] * self.scale, v[2] * self.scale],
+            p,
             axis,
             feed_mm_min: self.feed,
             rapid: self.rapid,
@@ -375,9 +484,8 @@ fn numeric_rows(file: &str, text: &str, header: &[&str]) -> Result<Vec<NumericRo
             .collect::<Result<Vec<f64>, _>>()?;
         let feed_mm_min = if values.len() == full {
             let f = values.pop().expect("full row");
-            if f <= 0.0 {
-                return Err(err(line, format!("feed_mm_min must be > 0, got {f}")));
-            }
+            runout_core::limits::feed_mm_min("feed_mm_min", f)
+                .map_err(|e| err(line, e.to_string()))?;
             Some(f)
         } else {
             None
@@ -408,6 +516,7 @@ pub fn parse_cl_csv(file: &str, text: &str) -> Result<Toolpath, ToolpathError> {
             .feed_mm_min
             .or_else(|| path.points.last().and_then(|p| p.feed_mm_min));
         let axis = unit_axis(file, row.line, [v[3], v[4], v[5]], &mut path.warnings)?;
+        check_point(file, row.line, &[v[0], v[1], v[2]])?;
         path.points.push(ToolpathPoint {
             p: [v[0], v[1], v[2]],
             axis,
@@ -525,6 +634,7 @@ pub fn parse_joint_csv(file: &str, text: &str) -> Result<Vec<JointBlock>, Toolpa
         let feed = row
             .feed_mm_min
             .or_else(|| out.last().and_then(|b| b.feed_mm_min));
+        check_point(file, row.line, &[v[0], v[1], v[2]])?;
         out.push(JointBlock {
             xyz: [v[0], v[1], v[2]],
             a_deg: v[3],

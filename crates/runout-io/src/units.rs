@@ -158,6 +158,19 @@ pub enum UnitError {
         /// Description of what was expected.
         expected: String,
     },
+    /// Beyond the largest magnitude accepted for the quantity
+    /// ([`runout_core::limits::MAX_ABS_QUANTITY`]).
+    #[error(
+        "`{text}` is out of range: expected |value| <= {max:e} {unit} (limit MAX_ABS_QUANTITY)"
+    )]
+    OutOfRange {
+        /// Input text.
+        text: String,
+        /// The largest magnitude.
+        max: f64,
+        /// The canonical unit.
+        unit: &'static str,
+    },
     /// NaN or infinite.
     #[error("`{text}` is not finite (expected {expected})")]
     NotFinite {
@@ -188,6 +201,38 @@ impl fmt::Display for Quantity {
 /// assert!(parse_quantity("nan", Quantity::LengthMm).is_err());
 /// ```
 pub fn parse_quantity(text: &str, q: Quantity) -> Result<f64, UnitError> {
+    let v = parse_unbounded(text, q).map_err(|e| match e {
+        UnitError::NotANumber { text, expected } => UnitError::NotANumber {
+            text: crate::textfile::quote(&text),
+            expected,
+        },
+        UnitError::WrongUnit {
+            text,
+            suffix,
+            expected,
+        } => UnitError::WrongUnit {
+            text: crate::textfile::quote(&text),
+            suffix: crate::textfile::quote(&suffix),
+            expected,
+        },
+        UnitError::NotFinite { text, expected } => UnitError::NotFinite {
+            text: crate::textfile::quote(&text),
+            expected,
+        },
+        other => other,
+    })?;
+    let max = runout_core::limits::max_abs_quantity(q.unit());
+    if v.abs() > max {
+        return Err(UnitError::OutOfRange {
+            text: crate::textfile::quote(text.trim()),
+            max,
+            unit: q.unit(),
+        });
+    }
+    Ok(v)
+}
+
+fn parse_unbounded(text: &str, q: Quantity) -> Result<f64, UnitError> {
     let t = text.trim();
     let expected = q.to_string();
     // split the numeric prefix from the suffix

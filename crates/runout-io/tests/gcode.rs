@@ -270,3 +270,21 @@ proptest! {
         }
     }
 }
+
+/// Fuzz crasher (issue 20, `nc_program` target): an incremental (G91) program with a word of 46
+/// decimals was rewritten with all-`None` offsets, because `desired − base` differs from the
+/// word's value by f64 rounding; now the program is reproduced byte for byte. The lexer also
+/// refuses a 400-digit word (issue 20 row 10) instead of reading it as infinity.
+#[test]
+fn fuzz_crasher_many_decimals_in_incremental_mode_is_reproduced() {
+    let bytes = include_bytes!("data/fuzz_nc_many_decimals.nc");
+    let text = std::str::from_utf8(bytes).unwrap();
+    let p = NcProgram::parse(text).unwrap();
+    let none = vec![None; p.motion_blocks().len()];
+    assert_eq!(p.rewrite(&none, &RewriteOptions::default()).unwrap(), text);
+    let zero = vec![Some([0.0; 3]); p.motion_blocks().len()];
+    assert_eq!(p.rewrite(&zero, &RewriteOptions::default()).unwrap(), text);
+    let e = lex(&format!("G1 X{}.0\n", "9".repeat(400))).unwrap_err();
+    assert!(e.to_string().contains("out of range"), "{e}");
+    assert!(e.to_string().len() < 300, "{e}");
+}

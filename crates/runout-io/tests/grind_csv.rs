@@ -70,7 +70,7 @@ fn errors_name_the_line() {
 
     r[5].3 = f64::NAN; // line 8
     let e = assemble(&grid_text(&r)).unwrap_err();
-    assert!(e.contains("row 8") && e.contains("radius_mm"), "{e}");
+    assert!(e.contains("line 8") && e.contains("radius_mm"), "{e}");
 
     let mut r = rows();
     r[9].3 = 3.4; // probe miss on line 12

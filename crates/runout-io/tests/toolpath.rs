@@ -172,3 +172,30 @@ fn joint_csv_for_machines_without_rtcp() {
         .to_string()
         .contains("no feed"));
 }
+
+/// Issue 20 row 9: a record that is not an APT word (`GOT0`, a typo) is an error naming the line;
+/// an unknown word is a warning naming the line; coordinates and feeds out of range are errors.
+#[test]
+fn unknown_records_and_out_of_range_numbers_are_not_dropped_silently() {
+    let base = "MULTAX/ON\nFEDRAT/MMPM,1200\nGOTO/0,0,5,0,0,1\n";
+    let e = parse_apt("t.apt", &format!("{base}GOT0/4,0,5,0,0,1\n")).unwrap_err();
+    assert!(
+        matches!(&e, ToolpathError::Parse { line: 4, message, .. } if message.contains("GOT0")),
+        "{e}"
+    );
+    let p = parse_apt("t.apt", &format!("{base}FOOBAR/1\nGOTO/4,0,5,0,0,1\n")).unwrap();
+    assert_eq!(p.points.len(), 2);
+    assert!(
+        p.warnings
+            .iter()
+            .any(|w| w.contains("t.apt:4") && w.contains("FOOBAR")),
+        "{:?}",
+        p.warnings
+    );
+    let e = parse_apt("t.apt", &format!("{base}GOTO/1e300,0,5,0,0,1\n")).unwrap_err();
+    assert!(e.to_string().contains("t.apt:4") && e.to_string().contains("MAX_COORDINATE_MM"));
+    let e = parse_apt("t.apt", "FEDRAT/MMPM,1e-300\nGOTO/0,0,5\n").unwrap_err();
+    assert!(e.to_string().contains("t.apt:1") && e.to_string().contains("MIN_FEED_MM_MIN"));
+    let e = parse_cl_csv("p.csv", "0,0,0,0,0,1,600\n1e9,0,0,0,0,1\n").unwrap_err();
+    assert!(e.to_string().contains("p.csv:2"), "{e}");
+}

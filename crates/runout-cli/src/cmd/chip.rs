@@ -193,10 +193,24 @@ fn compare_case(
     })
 }
 
+/// The case file and every file its cases name (toolpaths, joint tables; relative to the case
+/// file), for the output-is-not-an-input check.
+fn case_inputs(config: &Path, cases: &[ChipCase]) -> Vec<PathBuf> {
+    let base = config.parent().unwrap_or(Path::new("."));
+    let mut v = vec![config.to_path_buf()];
+    for c in cases {
+        for f in [&c.spec.toolpath, &c.spec.joints].into_iter().flatten() {
+            v.push(base.join(f));
+        }
+    }
+    v
+}
+
 fn compare(a: CompareArgs) -> Result<()> {
     let cases = select(read_cases(&a.config)?, a.case.as_deref(), &a.config)?;
     if let Some(j) = &a.json {
-        output::check_not_input(j, &[a.config.as_path()])?;
+        let inputs = case_inputs(&a.config, &cases);
+        output::check_not_input(j, &inputs.iter().map(|p| p.as_path()).collect::<Vec<_>>())?;
     }
     let params = EquivalentParams {
         phase_refinement: !a.no_phase_refinement,
@@ -389,8 +403,10 @@ fn eval_model(case: &ChipCase, model: &str) -> Result<Vec<f64>> {
 
 fn eval(a: EvalArgs) -> Result<()> {
     let case = select(read_cases(&a.config)?, a.case.as_deref(), &a.config)?.remove(0);
+    let inputs = case_inputs(&a.config, std::slice::from_ref(&case));
+    let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
     for out in [&a.out, &a.plot, &a.map, &a.json].into_iter().flatten() {
-        output::check_not_input(out, &[a.config.as_path()])?;
+        output::check_not_input(out, &inputs)?;
     }
     if a.plot_revolutions.is_nan() || a.plot_revolutions <= 0.0 {
         bail!(

@@ -230,7 +230,8 @@ struct Resolved {
 
 fn load_config(path: &Path, rate_flag: Option<&str>) -> Result<Resolved> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading config {file}"))?;
+    let text =
+        runout_io::textfile::read_text(path).with_context(|| format!("reading config {file}"))?;
     let cfg = ShankConfig::parse(&file, &text)?;
     let b = &cfg.shank;
     let n = |key: &str, v: &runout_io::config::Value, q| number(&file, key, v, q);
@@ -1447,6 +1448,7 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
         "condition_number": cal.condition_number,
     });
     if let Some(pj) = &a.json {
+        output::check_not_input(pj, &[&a.recording, &a.config])?;
         output::write_text(pj, &(serde_json::to_string_pretty(&j)? + "\n"))?;
     }
     if a.json.as_deref() != Some(Path::new("-")) {

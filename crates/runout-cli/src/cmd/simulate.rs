@@ -194,7 +194,7 @@ pub fn settings(
 ) -> Result<Settings> {
     let mut s = Settings::new();
     if let Some(path) = config {
-        let text = std::fs::read_to_string(path)
+        let text = runout_io::textfile::read_text(path)
             .with_context(|| format!("reading config {}", path.display()))?;
         s.push(layer_from_toml(&path.display().to_string(), &text, known)?);
     }
@@ -235,6 +235,7 @@ pub fn run(a: Args) -> Result<()> {
         case.sampling =
             runout_core::Sampling::new(case.sampling.revolutions, step_deg, case.sampling.disks)
                 .map_err(|e| anyhow::anyhow!("--sample-rate-hz {fs}: {e}"))?;
+        case.check_work()?;
     }
     let inputs: Vec<&std::path::Path> = a.config.iter().map(|p| p.as_path()).collect();
     for out in [&a.out, &a.json, &a.plot, &a.recording.recording]
@@ -311,9 +312,10 @@ fn write_recording(
     use rand_distr::{Distribution, Normal};
     let pct = parse_flag("--noise-percent", &r.noise_percent, Quantity::Dimensionless)?;
     let air = parse_flag("--air-cut-s", &r.air_cut_s, Quantity::TimeS)?;
-    if pct < 0.0 || air < 0.0 {
+    if !(pct >= 0.0 && air >= 0.0) {
         anyhow::bail!("--noise-percent and --air-cut-s must be >= 0 (got {pct}, {air})");
     }
+    runout_core::limits::result_size("--air-cut-s", 2.0 * air * fs + s.fx.len() as f64, 3.0)?;
     let delimiter = match r.delimiter.as_str() {
         "comma" => ',',
         "semicolon" => ';',

@@ -39,12 +39,19 @@ pub struct Sampling {
 }
 
 impl Sampling {
-    /// Largest number of angle samples one simulation holds in memory (≈ 5 GB of output).
-    pub const MAX_SAMPLES: usize = 100_000_000;
+    /// Largest number of angle samples one simulation holds in memory
+    /// ([`crate::limits::MAX_SAMPLES`]).
+    pub const MAX_SAMPLES: usize = crate::limits::MAX_SAMPLES;
 
     /// `revolutions` turns at `step_deg` degrees per sample with `disks` axial disks.
     pub fn new(revolutions: f64, step_deg: f64, disks: usize) -> Result<Self, ParamError> {
-        positive("revolutions", revolutions)?;
+        crate::limits::positive_at_most(
+            "revolutions",
+            revolutions,
+            crate::limits::MAX_REVOLUTIONS,
+            "revolutions",
+            "MAX_REVOLUTIONS",
+        )?;
         positive("step_deg", step_deg)?;
         if step_deg > 90.0 {
             return Err(ParamError::new(
@@ -53,15 +60,13 @@ impl Sampling {
                 step_deg,
             ));
         }
-        if disks == 0 {
-            return Err(ParamError::new("disks", "an integer >= 1", disks));
-        }
+        crate::limits::count("disks", disks, crate::limits::MAX_DISKS, "MAX_DISKS")?;
         let samples = revolutions * 360.0 / step_deg;
         if samples > Self::MAX_SAMPLES as f64 {
             return Err(ParamError::new(
                 "revolutions",
                 format!(
-                    "at most {} samples in one simulation (revolutions·360/step_deg)",
+                    "at most {} samples in one simulation (revolutions·360/step_deg; limit MAX_SAMPLES)",
                     Self::MAX_SAMPLES
                 ),
                 format!("{revolutions} revolutions at {step_deg}° = {samples:.3e} samples"),

@@ -66,8 +66,15 @@ fn check_range(z0: f64, z1: f64, n: usize) -> Result<(), ParamError> {
             z1,
         ));
     }
-    if n < 2 {
-        return Err(ParamError::new("points_per_flute", "an integer >= 2", n));
+    if !(2..=crate::limits::MAX_POINTS_PER_FLUTE).contains(&n) {
+        return Err(ParamError::new(
+            "points_per_flute",
+            format!(
+                "an integer in [2, {}] (limit MAX_POINTS_PER_FLUTE)",
+                crate::limits::MAX_POINTS_PER_FLUTE
+            ),
+            n,
+        ));
     }
     Ok(())
 }
@@ -112,6 +119,7 @@ impl EdgeLine {
         n: usize,
     ) -> Result<Self, ParamError> {
         check_range(z0, z1, n)?;
+        crate::limits::result_size("points_per_flute", flutes as f64 * n as f64, 8.0)?;
         let cutter = Cutter::flat(diameter_mm, flutes, helix_deg)?;
         Ok(EdgeLine {
             points: sample(&cutter, z0, z1, n),
@@ -130,9 +138,8 @@ impl EdgeLine {
         n: usize,
     ) -> Result<Self, ParamError> {
         check_range(z0, z1, n)?;
-        if flutes == 0 {
-            return Err(ParamError::new("flutes", "an integer >= 1", flutes));
-        }
+        crate::limits::teeth("flutes", flutes)?;
+        crate::limits::result_size("points_per_flute", flutes as f64 * n as f64, 8.0)?;
         let pitch = vec![TAU / flutes as f64; flutes];
         let cutter = Cutter::new(diameter_mm, pitch, helix_deg, z1, RadiusProfile::Ball)?;
         Ok(EdgeLine {

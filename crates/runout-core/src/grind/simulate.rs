@@ -34,6 +34,14 @@ pub fn uniform_grid(
     if angles < 3 {
         return Err(ParamError::new("angles", "an integer >= 3", angles));
     }
+    // checked before the grid is allocated
+    crate::limits::work(
+        "layers",
+        "probe points (layers × angles)",
+        layers as f64 * angles as f64,
+        crate::limits::MAX_PROBE_POINTS as f64,
+        "MAX_PROBE_POINTS",
+    )?;
     if u_b.is_nan() || u_a.is_nan() || u_b <= u_a {
         return Err(ParamError::new(
             "u_end_mm",

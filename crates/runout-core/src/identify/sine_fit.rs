@@ -60,6 +60,21 @@ impl ToothPeaks {
                     v,
                 ));
             }
+            // peak forces are magnitudes: a negative one would give a negative runout offset
+            if *v < 0.0 {
+                return Err(ParamError::new(
+                    format!("peaks_N[{i}]"),
+                    "a peak force >= 0 N (peaks are magnitudes, the largest force of each tooth)",
+                    v,
+                ));
+            }
+        }
+        if values_n.iter().all(|v| *v == 0.0) {
+            return Err(ParamError::new(
+                "peaks_N",
+                "peaks that are positive (at least one tooth > 0 N): all zero gives no runout",
+                "all 0",
+            ));
         }
         Ok(ToothPeaks {
             values: values_n,
@@ -372,6 +387,15 @@ pub fn sine_fit(
     };
     let rss_teeth: f64 = f.iter().zip(&fitted).map(|(v, p)| (v - p).powi(2)).sum();
 
+    if !(rho.is_finite() && c.is_finite() && amp.is_finite()) {
+        return Err(IdentifyError::Singular {
+            what: "the per-tooth sine fit".into(),
+            reason: format!(
+                "the peaks give no finite runout (mean C = {c:e} N, amplitude A = {amp:e} N); \
+                 check the peak forces (N) and f_z"
+            ),
+        });
+    }
     let mut warnings = Vec::new();
     if k == 3 {
         warnings.push(

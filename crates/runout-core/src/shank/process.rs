@@ -152,6 +152,25 @@ impl ShankSetup {
                 format!("{:.1} samples per revolution", self.samples_per_rev()),
             ));
         }
+        if self.samples_per_rev() > crate::limits::MAX_SAMPLES_PER_REV as f64 {
+            return Err(p(
+                "sample_rate_hz",
+                &format!(
+                    "at most {} samples per spindle revolution (limit MAX_SAMPLES_PER_REV)",
+                    crate::limits::MAX_SAMPLES_PER_REV
+                ),
+                format!("{:.4e} samples per revolution", self.samples_per_rev()),
+            ));
+        }
+        for (q, &(a, b)) in self.air_cut_s.iter().enumerate() {
+            if !(a.is_finite() && b.is_finite() && a >= 0.0 && a < b) {
+                return Err(p(
+                    &format!("air_cut_s[{q}]"),
+                    "a window [start, end] in s with 0 <= start < end",
+                    format!("[{}, {}]", crate::limits::show(a), crate::limits::show(b)),
+                ));
+            }
+        }
         if !(self.stiffness_n_per_mm.is_finite() && self.stiffness_n_per_mm > 0.0) {
             return Err(p(
                 "stiffness_N_per_um",
@@ -182,7 +201,7 @@ pub struct SampleRange {
 impl SampleRange {
     /// Samples in the range.
     pub fn len(&self) -> u64 {
-        self.end - self.start
+        self.end.saturating_sub(self.start)
     }
 
     /// True if empty.
@@ -236,7 +255,8 @@ impl Survey {
             .map(|&(a, b)| {
                 let s = ((a - setup.start_time_s) / dt).ceil().max(0.0) as u64;
                 let e = ((b - setup.start_time_s) / dt).floor().max(0.0) as u64;
-                let e = e.min(s + cap as u64);
+                // a window shorter than one sample is empty, never reversed
+                let e = e.min(s + cap as u64).max(s);
                 (SampleRange { start: s, end: e }, vec![Vec::new(); nd])
             })
             .collect();
@@ -663,8 +683,9 @@ pub fn analyse(survey: &SurveyResult) -> Result<ShankAnalysis, ShankError> {
             .given
             .iter()
             .map(|(r, _)| SampleRange {
-                start: r.start,
-                end: r.end.min(survey.samples),
+                // a window past the end of the recording is empty (and refused below)
+                start: r.start.min(survey.samples),
+                end: r.end.min(survey.samples).max(r.start.min(survey.samples)),
             })
             .collect();
         let spr = s.samples_per_rev();

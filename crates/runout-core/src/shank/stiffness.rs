@@ -62,7 +62,7 @@ impl ShankBeam {
     ) -> Result<Self, ParamError> {
         let beam = ShankBeam {
             modulus_n_per_mm2: positive("modulus_gpa", modulus_gpa)? * 1e3,
-            diameter_mm: positive("diameter_mm", diameter_mm)?,
+            diameter_mm: crate::limits::diameter("diameter_mm", diameter_mm)?,
             tool_length_mm: positive("tool_length_mm", tool_length_mm)?,
             l1_mm,
             l2_mm,

@@ -25,7 +25,7 @@ use runout_core::chip::{
     CircularFeed, ClPath, ConstantSwing, JointPath, SpindleSense, StraightFeed, ToolKinematics,
     Vec3,
 };
-use runout_core::{Cutter, RadiusProfile, Runout};
+use runout_core::{limits, Cutter, RadiusProfile, Runout};
 use serde::Deserialize;
 use std::f64::consts::TAU;
 use std::path::Path;
@@ -185,7 +185,13 @@ pub fn parse_case_specs(file: &str, text: &str) -> Result<Vec<ChipCaseSpec>, Chi
         file: file.into(),
         message,
     };
-    let mut doc: toml::Table = toml::from_str(text).map_err(|e| perr(e.to_string()))?;
+    let mut doc: toml::Table =
+        toml::from_str(text).map_err(|e| perr(super::toml_error(text, &e)))?;
+    if let Some(key) = doc.iter().find_map(|(k, v)| super::non_finite_key(v, k)) {
+        return Err(perr(format!(
+            "key `{key}`: expected a finite number, got nan or inf"
+        )));
+    }
     let defaults = match doc.remove("defaults") {
         Some(toml::Value::Table(t)) => t,
         Some(_) => return Err(perr("`defaults` must be a table".into())),
@@ -211,7 +217,13 @@ pub fn parse_case_specs(file: &str, text: &str) -> Result<Vec<ChipCaseSpec>, Chi
             merged.extend(t);
             toml::Value::Table(merged)
                 .try_into::<ChipCaseSpec>()
-                .map_err(|e| perr(format!("case {}: {e}", n + 1)))
+                .map_err(|e| {
+                    perr(format!(
+                        "case {}: {}",
+                        n + 1,
+                        super::clip_quoted(e.message())
+                    ))
+                })
         })
         .collect()
 }
@@ -219,9 +231,12 @@ pub fn parse_case_specs(file: &str, text: &str) -> Result<Vec<ChipCaseSpec>, Chi
 /// Read and resolve every case of `path`.
 pub fn read_cases(path: &Path) -> Result<Vec<ChipCase>, ChipConfigError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| ChipConfigError::Io {
+    let text = crate::textfile::read_text(path).map_err(|e| ChipConfigError::Parse {
         file: file.clone(),
-        source,
+        message: match e.line {
+            Some(l) => format!("line {l}: {}", e.message),
+            None => e.message,
+        },
     })?;
     let base = path.parent().unwrap_or(Path::new("."));
     parse_case_specs(&file, &text)?
@@ -252,29 +267,37 @@ fn cutter_of(s: &ChipCaseSpec) -> Result<Cutter, String> {
             ))
         }
         Some(p) => p.iter().map(|d| d.to_radians()).collect(),
-        None if s.teeth == 0 => return Err("teeth: expected an integer >= 1".into()),
-        None => vec![TAU / s.teeth as f64; s.teeth],
+        // checked before anything is allocated per tooth
+        None => {
+            limits::teeth("teeth", s.teeth).map_err(|e| e.to_string())?;
+            vec![TAU / s.teeth as f64; s.teeth]
+        }
     };
     Cutter::new(s.diameter_mm, pitch, s.helix_deg, f64::INFINITY, profile)
         .map_err(|e| e.to_string())
 }
 
-fn runout_of(s: &ChipCaseSpec) -> Result<Runout, String> {
+fn runout_of(s: &ChipCaseSpec, cutter: &Cutter) -> Result<Runout, String> {
     Runout::new(s.runout_um * 1e-3, s.runout_angle_deg.to_radians())
         .and_then(|r| r.with_tilt(s.tilt_um_per_mm * 1e-3, s.tilt_angle_deg.to_radians()))
+        .and_then(|r| {
+            limits::runout_vs_radius("runout_um", s.runout_um * 1e-3, cutter.radius()).map(|_| r)
+        })
         .map_err(|e| e.to_string())
 }
 
 fn feed_speed(s: &ChipCaseSpec) -> Result<f64, String> {
     let fz = s.fz_mm.ok_or("fz_mm: required for this motion")?;
-    if !(fz.is_finite() && fz > 0.0) {
-        return Err(format!("fz_mm: expected > 0, got {fz}"));
-    }
+    limits::positive_at_most("fz_mm", fz, limits::MAX_FZ_MM, "mm", "MAX_FZ_MM")
+        .map_err(|e| e.to_string())?;
     Ok(fz * s.teeth as f64 * s.rpm / 60.0)
 }
 
 /// Motion of a case and the warnings of reading its toolpath.
 fn motion_of(s: &ChipCaseSpec, base: &Path) -> Result<(Motion, Vec<String>), String> {
+    if let Some(f) = s.feed_mm_min {
+        limits::feed_mm_min("feed_mm_min", f).map_err(|e| e.to_string())?;
+    }
     let along_x = |v: f64| Vec3::new(v, 0.0, 0.0);
     Ok(match s.motion.as_str() {
         "straight" => (
@@ -318,7 +341,7 @@ fn motion_of(s: &ChipCaseSpec, base: &Path) -> Result<(Motion, Vec<String>), Str
                 .ok_or("joints: required for motion joints")?;
             let full = base.join(file);
             let name = full.display().to_string();
-            let text = std::fs::read_to_string(&full).map_err(|e| format!("{name}: {e}"))?;
+            let text = crate::textfile::read_text(&full).map_err(|e| e.to_string())?;
             let blocks = parse_joint_csv(&name, &text).map_err(|e| e.to_string())?;
             let pts = joint_points(&name, &blocks, s.feed_mm_min).map_err(|e| e.to_string())?;
             let path = JointPath::new(&pts, s.pivot_mm).map_err(|e| format!("{name}: {e}"))?;
@@ -344,7 +367,7 @@ pub fn resolve_case(
         message,
     };
     let cutter = cutter_of(&spec).map_err(err)?;
-    let runout = runout_of(&spec).map_err(err)?;
+    let runout = runout_of(&spec, &cutter).map_err(err)?;
     let sense = match spec.spindle.as_str() {
         "cw" => SpindleSense::Clockwise,
         "ccw" => SpindleSense::CounterClockwise,
@@ -368,11 +391,23 @@ pub fn resolve_case(
             "heights_mm: expected one or more heights >= 0 (mm)".into()
         ));
     }
-    if spec.samples_per_rev == 0 || spec.revolutions.is_nan() || spec.revolutions < 0.0 {
-        return Err(err(
-            "samples_per_rev >= 1 and revolutions >= 0 expected".into()
-        ));
-    }
+    limits::count(
+        "samples_per_rev",
+        spec.samples_per_rev,
+        limits::MAX_SAMPLES_PER_REV,
+        "MAX_SAMPLES_PER_REV",
+    )
+    .and_then(|_| {
+        limits::within(
+            "revolutions",
+            spec.revolutions,
+            0.0,
+            limits::MAX_REVOLUTIONS,
+            "(0 = the whole path)",
+            "MAX_REVOLUTIONS",
+        )
+    })
+    .map_err(|e| err(e.to_string()))?;
     let period = kin.period();
     let t0 = spec.start_s.unwrap_or(period);
     let span = match (duration, spec.revolutions) {
@@ -386,7 +421,22 @@ pub fn resolve_case(
     }
     let samples = ((span / period) * spec.samples_per_rev as f64)
         .round()
-        .max(1.0) as usize;
+        .max(1.0);
+    // the grid's size, checked before it is allocated (a tiny feed makes a long path)
+    let grid = samples * (cutter.teeth() * spec.heights_mm.len()) as f64;
+    limits::work(
+        "samples_per_rev",
+        &format!(
+            "evaluation points ({:.4e} s of path = {:.4e} revolutions)",
+            span,
+            span / period
+        ),
+        grid,
+        limits::MAX_SAMPLES as f64,
+        "MAX_SAMPLES",
+    )
+    .map_err(|e| err(e.to_string()))?;
+    let samples = samples as usize;
     let points = sample_grid(cutter.teeth(), &spec.heights_mm, t0, span, samples);
     Ok(ChipCase {
         name: spec.name.clone(),

@@ -200,6 +200,79 @@ impl Settings {
     }
 }
 
+/// A TOML error as `line L, column C: message`, without the source snippet the parser's own
+/// display adds (which would echo a whole long line) and with every `quoted` part of the
+/// message clipped to 80 characters.
+pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
+    let msg = clip_quoted(e.message().trim());
+    match e.span().and_then(|s| text.get(..s.start)) {
+        Some(before) => {
+            let line = before.matches('\n').count() + 1;
+            let col = before[before.rfind('\n').map_or(0, |i| i + 1)..]
+                .chars()
+                .count()
+                + 1;
+            format!("TOML parse error at line {line}, column {col}: {msg}")
+        }
+        None => format!("TOML parse error: {msg}"),
+    }
+}
+
+/// Clip each `…`-quoted part of a message to 80 characters, and the whole to 400.
+pub fn clip_quoted(msg: &str) -> String {
+    let clipped = msg
+        .split('`')
+        .enumerate()
+        .map(|(i, p)| {
+            if i % 2 == 1 {
+                crate::textfile::quote(p)
+            } else {
+                p.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("`");
+    match clipped.char_indices().nth(400) {
+        Some((i, _)) => format!("{}…", &clipped[..i]),
+        None => clipped,
+    }
+}
+
+/// The key path of the first non-finite float (`nan`, `inf`) anywhere in a TOML value.
+pub(crate) fn non_finite_key(v: &toml::Value, path: &str) -> Option<String> {
+    match v {
+        toml::Value::Float(f) if !f.is_finite() => Some(path.to_string()),
+        toml::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| non_finite_key(x, &format!("{path}[{i}]"))),
+        toml::Value::Table(t) => t.iter().find_map(|(k, x)| {
+            let p = if path.is_empty() {
+                k.clone()
+            } else {
+                format!("{path}.{k}")
+            };
+            non_finite_key(x, &p)
+        }),
+        _ => None,
+    }
+}
+
+/// Refuse `nan` and `inf` anywhere in a parsed TOML document (every number the toolkit reads
+/// is finite), naming the key.
+pub fn reject_non_finite(file: &str, table: &toml::Table) -> Result<(), ConfigError> {
+    for (k, v) in table {
+        if let Some(key) = non_finite_key(v, k) {
+            return Err(ConfigError::Key {
+                source_name: file.into(),
+                key,
+                message: "expected a finite number, got nan or inf".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Read a TOML config file's text into a [`Layer`], accepting only `known` keys.
 ///
 /// Arrays become comma-separated text (for [`Settings::list`]). Unknown keys and malformed TOML
@@ -217,8 +290,9 @@ pub fn layer_from_toml(file: &str, text: &str, known: &[&str]) -> Result<Layer, 
         .parse()
         .map_err(|e: toml::de::Error| ConfigError::Parse {
             file: file.into(),
-            message: e.to_string(),
+            message: toml_error(text, &e),
         })?;
+    reject_non_finite(file, &table)?;
     let mut values = BTreeMap::new();
     for (k, v) in table {
         if !known.contains(&k.as_str()) {

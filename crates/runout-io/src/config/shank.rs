@@ -206,9 +206,12 @@ impl Default for ProcessingSection {
 impl ShankConfig {
     /// Parse the TOML text of `file` (unknown keys are errors with line and column).
     pub fn parse(file: &str, text: &str) -> Result<Self, ConfigError> {
+        if let Ok(t) = text.parse::<toml::Table>() {
+            super::reject_non_finite(file, &t)?;
+        }
         toml::from_str(text).map_err(|e| ConfigError::Parse {
             file: file.into(),
-            message: e.to_string(),
+            message: super::toml_error(text, &e),
         })
     }
 }

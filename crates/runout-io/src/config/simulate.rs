@@ -4,7 +4,8 @@
 use super::{ConfigError, Settings};
 use crate::units::Quantity;
 use runout_core::{
-    Cut, Cutter, CuttingCoefficients, MillingMode, ParamError, RadiusProfile, Runout, Sampling,
+    limits, Cut, Cutter, CuttingCoefficients, MillingMode, ParamError, RadiusProfile, Runout,
+    Sampling,
 };
 
 /// Every key of a simulation case: (key, quantity, help). The CLI flag is `--key-with-dashes`.
@@ -159,13 +160,8 @@ pub fn resolve_cutter(s: &Settings) -> Result<Cutter, ConfigError> {
         flag: "teeth".into(),
         what: "number of teeth".into(),
     })?;
-    if teeth == 0 {
-        return Err(ConfigError::Key {
-            source_name: s.origin("teeth").unwrap_or("config").into(),
-            key: "teeth".into(),
-            message: "expected an integer >= 1, got 0".into(),
-        });
-    }
+    // before anything is allocated per tooth
+    limits::teeth("teeth", teeth).map_err(|e| key_err(s, e))?;
     let d = s.require("diameter_mm", Quantity::LengthMm, "cutter diameter")?;
     let helix = s.or("helix_deg", Quantity::AngleDeg, 0.0)?;
     let flute = s.or("flute_length_mm", Quantity::LengthMm, f64::INFINITY)?;
@@ -263,8 +259,29 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
     let tilt_ang = s.or("tilt_angle_deg", Quantity::AngleDeg, 0.0)?;
     let runout = Runout::new(rho, lam.to_radians())
         .and_then(|r| r.with_tilt(tilt, tilt_ang.to_radians()))
+        .and_then(|r| limits::runout_vs_radius("runout_um", rho, cutter.radius()).map(|_| r))
         .map_err(|e| key_err(s, e))?;
 
+    for (k, q) in [
+        ("ktc", Quantity::ForcePerArea),
+        ("krc", Quantity::ForcePerArea),
+        ("kac", Quantity::ForcePerArea),
+        ("kte", Quantity::ForcePerLength),
+        ("kre", Quantity::ForcePerLength),
+        ("kae", Quantity::ForcePerLength),
+    ] {
+        if let Some(v) = s.quantity(k, q)? {
+            limits::within(
+                k,
+                v,
+                -limits::MAX_COEFFICIENT,
+                limits::MAX_COEFFICIENT,
+                "N/mm² (shear) or N/mm (edge)",
+                "MAX_COEFFICIENT",
+            )
+            .map_err(|e| key_err(s, e))?;
+        }
+    }
     let coefficients = CuttingCoefficients::new(
         [
             s.require("ktc", Quantity::ForcePerArea, "K_tc")?,
@@ -284,7 +301,19 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
     let disks = s
         .count("disks")?
         .unwrap_or(if helix == 0.0 { 1 } else { 50 });
-    let sampling = Sampling::new(revolutions, step, disks).map_err(|e| key_err(s, e))?;
+    let sampling = Sampling::new(revolutions, step, disks)
+        .and_then(|sm| {
+            limits::within(
+                "revolutions",
+                revolutions,
+                limits::MIN_SIMULATED_REVOLUTIONS,
+                limits::MAX_REVOLUTIONS,
+                "(every tooth's peak needs a full revolution)",
+                "MIN_SIMULATED_REVOLUTIONS",
+            )
+            .map(|_| sm)
+        })
+        .map_err(|e| key_err(s, e))?;
     let chip_model = s.text("chip_model")?.unwrap_or_else(|| "arc".into());
     if !CHIP_MODELS.contains(&chip_model.as_str()) {
         return Err(ConfigError::Key {
@@ -296,12 +325,45 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
             ),
         });
     }
-    Ok(SimulateCase {
+    let case = SimulateCase {
         cutter,
         runout,
         cut,
         coefficients,
         sampling,
         chip_model,
-    })
+    };
+    case.check_work()?;
+    Ok(case)
+}
+
+impl SimulateCase {
+    /// The work and memory of this simulation against [`runout_core::limits`]: chip evaluations
+    /// (samples × disks × K × K look-back teeth, × K again for the exact model) and the size of
+    /// the result (samples × (4 + K) values). Checked before anything is simulated; call it again
+    /// after changing `sampling`.
+    pub fn check_work(&self) -> Result<(), ConfigError> {
+        let k = self.cutter.teeth() as f64;
+        let n = self.sampling.revolutions * std::f64::consts::TAU / self.sampling.step;
+        let per = if self.chip_model == "exact" {
+            k * k * k
+        } else {
+            k * k
+        };
+        let evaluations = n * self.sampling.disks as f64 * per;
+        let err = |e: ParamError| ConfigError::Key {
+            source_name: "simulation size".into(),
+            key: "teeth, disks, revolutions, step_deg".into(),
+            message: format!("expected {}, got {}", e.expected, e.got),
+        };
+        limits::work(
+            "teeth",
+            "chip evaluations",
+            evaluations,
+            limits::MAX_EVALUATIONS,
+            "MAX_EVALUATIONS",
+        )
+        .and_then(|_| limits::result_size("revolutions", n, 4.0 + k))
+        .map_err(err)
+    }
 }

@@ -106,6 +106,10 @@ fn lex_line(text: &str, number: usize, content: Range<usize>) -> Result<Line, Nc
     })
 }
 
+/// Largest |value| of an NC word: the coordinate limit in µm (words are mm or inch coordinates,
+/// feeds, speeds, line numbers).
+const MAX_WORD_VALUE: f64 = runout_core::limits::MAX_COORDINATE_MM * 1e3;
+
 /// Letter, optional blanks, then [+-]digits[.digits] or [+-].digits.
 fn lex_word(text: &str, at: usize, end: usize) -> Result<Word, (usize, String)> {
     let b = text.as_bytes();
@@ -138,12 +142,23 @@ fn lex_word(text: &str, at: usize, end: usize) -> Result<Word, (usize, String)> 
             format!("word `{letter}` has no number (variables, expressions and named programs are not supported)"),
         ));
     }
-    let value: f64 = text[num_start..i].parse().map_err(|_| {
-        (
+    let written = &text[num_start..i];
+    let quoted = || match written.char_indices().nth(80) {
+        Some((n, _)) => format!("{}…", &written[..n]),
+        None => written.to_string(),
+    };
+    let value: f64 = written
+        .parse()
+        .map_err(|_| (num_start, format!("`{}` is not a number", quoted())))?;
+    if !(value.is_finite() && value.abs() <= MAX_WORD_VALUE) {
+        return Err((
             num_start,
-            format!("`{}` is not a number", &text[num_start..i]),
-        )
-    })?;
+            format!(
+                "word `{letter}`: number `{}` out of range (|value| <= {MAX_WORD_VALUE:e}, limit MAX_COORDINATE_MM·10³)",
+                quoted()
+            ),
+        ));
+    }
     Ok(Word {
         letter,
         value,

@@ -240,7 +240,10 @@ impl<'a> NcProgram<'a> {
                             0.0
                         };
                         let value = desired - base;
-                        if (value - w.value).abs() < half_unit(dec) {
+                        // a word written with more decimals than f64 holds is kept unless the
+                        // change is above the rounding of `desired - base`
+                        let rounding = 8.0 * f64::EPSILON * desired.abs().max(base.abs()).max(1.0);
+                        if (value - w.value).abs() < half_unit(dec).max(rounding) {
                             cmd[a] = Some(base + w.value);
                         } else {
                             let s = format_number(value, dec);

@@ -71,12 +71,20 @@ impl Table {
                     vals.push(None);
                     continue;
                 }
-                let v: f64 = cell.parse().map_err(|_| {
-                    err(
-                        Some(line),
-                        format!("column `{}`: `{cell}` is not a number", names[k]),
-                    )
-                })?;
+                let v: f64 = cell
+                    .parse()
+                    .ok()
+                    .filter(|v: &f64| v.is_finite())
+                    .ok_or_else(|| {
+                        err(
+                            Some(line),
+                            format!(
+                                "column `{}`: `{}` is not a finite number",
+                                names[k],
+                                crate::textfile::quote(cell)
+                            ),
+                        )
+                    })?;
                 vals.push(Some(v));
             }
             rows.push((line, vals));

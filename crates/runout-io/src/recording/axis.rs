@@ -68,9 +68,12 @@ impl AxisMapping {
             .map(str::trim)
             .filter(|e| !e.is_empty())
         {
-            let (lhs, rhs) = entry
-                .split_once('=')
-                .ok_or_else(|| err(format!("`{entry}` is not of the form `x = -Fy`")))?;
+            let (lhs, rhs) = entry.split_once('=').ok_or_else(|| {
+                err(format!(
+                    "`{}` is not of the form `x = -Fy`",
+                    crate::textfile::quote(entry)
+                ))
+            })?;
             let axis = match lhs.trim().to_ascii_lowercase().as_str() {
                 "x" => Axis::X,
                 "y" => Axis::Y,
@@ -95,7 +98,10 @@ impl AxisMapping {
                 return Err(err(format!("axis {} given twice", axis.letter())));
             }
             if axes.iter().flatten().any(|s| s.channel == channel) {
-                return Err(err(format!("channel `{channel}` used for two axes")));
+                return Err(err(format!(
+                    "channel `{}` used for two axes",
+                    crate::textfile::quote(channel)
+                )));
             }
             axes[axis.index()] = Some(AxisSource {
                 channel: channel.to_string(),

@@ -39,7 +39,11 @@ pub enum RecordingError {
         message: String,
     },
     /// A requested column is not in the header.
-    #[error("{file}:{line}: no column `{name}` (columns in the header: {available})")]
+    #[error(
+        "{file}:{line}: no column `{}` (columns in the header: {})",
+        crate::textfile::quote(.name),
+        crate::textfile::quote(.available)
+    )]
     MissingColumn {
         /// The file.
         file: String,
@@ -65,7 +69,10 @@ pub enum RecordingError {
         hint: String,
     },
     /// A cell of a selected column is not a finite number.
-    #[error("{file}:{line}:{column}: `{text}` in column `{name}` is not a finite number")]
+    #[error(
+        "{file}:{line}:{column}: `{text}` in column `{}` is not a finite number",
+        crate::textfile::quote(.name)
+    )]
     NotNumeric {
         /// The file.
         file: String,

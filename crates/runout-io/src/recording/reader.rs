@@ -14,7 +14,7 @@ use std::path::Path;
 type Result<T> = std::result::Result<T, RecordingError>;
 
 /// Longest accepted line; a longer one is reported (bounded memory on garbage input).
-const MAX_LINE_BYTES: u64 = 1 << 20;
+const MAX_LINE_BYTES: u64 = runout_core::limits::MAX_LINE_BYTES as u64;
 /// Data rows inspected at open for the decimal separator and the time step.
 const PEEK_ROWS: usize = 1000;
 /// Default rows per chunk.
@@ -702,6 +702,16 @@ fn read_dynoware_header<R: BufRead>(
                 "DynoWare header ended before the channel-name row (e.g. `Time,Fx,Fy,Fz`)".into(),
             ));
         };
+        if lines.bytes > runout_core::limits::MAX_HEADER_BYTES as u64 {
+            return Err(header_err(
+                n,
+                format!(
+                    "DynoWare header longer than {} bytes without a channel-name row (limit \
+                     MAX_HEADER_BYTES)",
+                    runout_core::limits::MAX_HEADER_BYTES
+                ),
+            ));
+        }
         let s = decode(buf);
         match key_line(&s, delimiter as char) {
             Some(kv) => metadata.push(kv),

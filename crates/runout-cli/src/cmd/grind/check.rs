@@ -110,9 +110,12 @@ pub fn run(a: CheckArgs) -> Result<()> {
     let off = pair("offset-um", &a.offset_um, Quantity::LengthUm)?;
     let tilt = pair("tilt-um-per-mm", &a.tilt_um_per_mm, Quantity::TiltUmPerMm)?;
     let sigma = q("noise-um", &a.noise_um, Quantity::LengthUm)? * 1e-3;
-    if a.draws == 0 {
-        bail!("--draws: expected an integer >= 1");
-    }
+    runout_core::limits::count(
+        "--draws",
+        a.draws,
+        runout_core::limits::MAX_DRAWS,
+        "MAX_DRAWS",
+    )?;
     let range = match a.outside.as_str() {
         "clamp" => RangePolicy::Clamp,
         "extrapolate" => RangePolicy::Extrapolate,
@@ -130,6 +133,13 @@ pub fn run(a: CheckArgs) -> Result<()> {
     )?;
     let grid = uniform_grid(u0, u1, a.layers, a.angles)?;
     let (edge, _, _) = edge(&a.edge, d, u1)?;
+    runout_core::limits::work(
+        "--draws",
+        "evaluations (draws × probe points × edge points)",
+        a.draws as f64 * (a.layers * a.angles) as f64 * edge.points.len() as f64,
+        runout_core::limits::MAX_EVALUATIONS,
+        "MAX_EVALUATIONS",
+    )?;
     let [bil, har] = mean_checks(&bar, &grid, &edge, sigma, &a, range)?;
     let um = |x: f64| x * 1e3;
     let row = |c: &GrindCheck| {

@@ -181,7 +181,7 @@ pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
     inputs.extend(a.nc.as_deref());
     for out in [&a.out, &a.path_out, &a.json].into_iter().flatten() {
         output::check_not_input(out, &inputs)?;
-        if a.nc.as_deref().is_some_and(|n| same_file(out, n)) {
+        if a.nc.as_deref().is_some_and(|n| output::same_file(out, n)) {
             bail!(
                 "refusing to write {}: it is the input NC program",
                 out.display()
@@ -213,11 +213,6 @@ pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
         print_text(&grid, &map, &comp, nc_summary.as_ref());
     }
     Ok(())
-}
-
-fn same_file(a: &Path, b: &Path) -> bool {
-    let c = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
-    c(a) == c(b)
 }
 
 /// Summary of the NC rewrite.

@@ -67,7 +67,7 @@ pub(crate) fn q(flag: &str, text: &str, quantity: Quantity) -> Result<f64> {
 }
 
 pub(crate) fn read(path: &Path, what: &str) -> Result<String> {
-    std::fs::read_to_string(path).with_context(|| format!("reading {what} {}", path.display()))
+    runout_io::textfile::read_text(path).with_context(|| format!("reading {what}"))
 }
 
 /// The edge and, for CSV edges, the wheel positions and the CSV path.

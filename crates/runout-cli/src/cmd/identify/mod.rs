@@ -34,7 +34,10 @@ pub fn run(a: Args) -> Result<()> {
     match a.command {
         Some(Command::Peaks(p)) => peaks::run(p),
         Some(Command::Tests(t)) => tests::run(t),
-        None => recording::run(a.recording),
+        None => {
+            crate::output::check_distinct(&a.recording.recordings, "recordings")?;
+            recording::run(a.recording)
+        }
     }
 }
 

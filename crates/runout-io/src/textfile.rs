@@ -1,0 +1,120 @@
+//! Reading a whole text file (table, config, toolpath, NC program) with bounded memory: files
+//! larger than [`MAX_TABLE_BYTES`] and lines longer than [`MAX_LINE_BYTES`] are refused before
+//! they are parsed, and messages quote at most 80 characters of the offending text.
+
+use runout_core::limits::{MAX_LINE_BYTES, MAX_TABLE_BYTES};
+use std::io::Read;
+use std::path::Path;
+
+/// Why a text file could not be read; `Display` gives `file[:line]: message`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+pub struct TextFileError {
+    /// The file.
+    pub file: String,
+    /// 1-based line, where the problem is on one line.
+    pub line: Option<usize>,
+    /// What is wrong and what the limit is.
+    pub message: String,
+}
+
+/// At most 80 characters of `text` (with `…` when cut), for messages.
+pub fn quote(text: &str) -> String {
+    match text.char_indices().nth(80) {
+        Some((i, _)) => format!("{}…", &text[..i]),
+        None => text.to_string(),
+    }
+}
+
+/// Read `path` as UTF-8 text, refusing files over [`MAX_TABLE_BYTES`] (checked on the size
+/// before reading, and again while reading for files without a size such as pipes) and lines
+/// over [`MAX_LINE_BYTES`].
+pub fn read_text(path: &Path) -> Result<String, TextFileError> {
+    let file = path.display().to_string();
+    let err = |line: Option<usize>, message: String| TextFileError {
+        file: file.clone(),
+        line,
+        message,
+    };
+    let too_big = |size: u64| {
+        err(
+            None,
+            format!(
+                "{size} bytes: larger than the {MAX_TABLE_BYTES} bytes a table, config or toolpath \
+                 may have (limit MAX_TABLE_BYTES); split the file"
+            ),
+        )
+    };
+    let f = std::fs::File::open(path).map_err(|e| err(None, format!("cannot read: {e}")))?;
+    let meta = f
+        .metadata()
+        .map_err(|e| err(None, format!("cannot read: {e}")))?;
+    if meta.is_dir() {
+        return Err(err(None, "is a folder, expected a file".into()));
+    }
+    if meta.len() > MAX_TABLE_BYTES {
+        return Err(too_big(meta.len()));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    f.take(MAX_TABLE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| err(None, format!("cannot read: {e}")))?;
+    if bytes.len() as u64 > MAX_TABLE_BYTES {
+        return Err(too_big(bytes.len() as u64));
+    }
+    check_lines(&file, &bytes)?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let raw = e.as_bytes();
+        let line = raw[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+        err(
+            Some(line),
+            "not UTF-8 text (a binary file, or another encoding: save it as UTF-8)".into(),
+        )
+    })
+}
+
+/// Refuse lines longer than [`MAX_LINE_BYTES`].
+fn check_lines(file: &str, bytes: &[u8]) -> Result<(), TextFileError> {
+    for (n, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        if line.len() > MAX_LINE_BYTES {
+            let head = String::from_utf8_lossy(&line[..line.len().min(320)]);
+            return Err(TextFileError {
+                file: file.into(),
+                line: Some(n + 1),
+                message: format!(
+                    "line of {} bytes: longer than {MAX_LINE_BYTES} (limit MAX_LINE_BYTES), starting `{}`",
+                    line.len(),
+                    quote(&head)
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn long_lines_and_big_files_are_refused_with_a_short_quote() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("one_line.csv");
+        std::fs::write(&p, "a".repeat(MAX_LINE_BYTES + 10)).unwrap();
+        let e = read_text(&p).unwrap_err();
+        assert_eq!(e.line, Some(1));
+        assert!(e.message.contains("MAX_LINE_BYTES"), "{e}");
+        assert!(e.to_string().len() < 300, "{e}");
+        let big = dir.path().join("big.csv");
+        std::fs::File::create(&big)
+            .unwrap()
+            .set_len(MAX_TABLE_BYTES + 1)
+            .unwrap();
+        let e = read_text(&big).unwrap_err();
+        assert!(e.message.contains("MAX_TABLE_BYTES"), "{e}");
+        let ok = dir.path().join("ok.csv");
+        std::fs::write(&ok, "a,b\n1,2\n").unwrap();
+        assert_eq!(read_text(&ok).unwrap(), "a,b\n1,2\n");
+    }
+}
