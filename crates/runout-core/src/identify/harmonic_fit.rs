@@ -898,8 +898,8 @@ pub(crate) fn harmonic_fit(
     // Stage 1 (scans and LM from rough starts) runs on a model with 5× coarser disks (helix lag
     // ≤ 0.5° per disk): it only has to bring every parameter near the optimum, which stage 2
     // then refines on the full model (the compass search and LM there are local). Measured on
-    // the five-feed 2-flute bench: fitted-mode fit 3.9 s → 1.35 s with the stage-2 changes below
-    // (docs/measuring-chain.md, "Speed").
+    // the five-feed 2-flute bench: fitted-mode fit 3.9 s → 0.79 s together with the stage-2
+    // changes below (docs/measuring-chain.md, "Speed").
     // (and on a 2× instead of 4× oversampled grid: 4× is needed for the final accuracy — 2×
     // left ζ 9 % high in the K = 4 round trip — but not to get near the optimum)
     let coarse = build((disks / 5).max(1), COARSE_OVERSAMPLE);
