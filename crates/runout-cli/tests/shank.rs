@@ -858,3 +858,94 @@ fn shank_force_and_calibrate_end_quietly_on_a_closed_pipe() {
         );
     }
 }
+
+/// Issue 20 acceptance for the shank commands (the flag property test covers the others): each
+/// numeric flag of `shank force` and `shank calibrate` set to special values — no panic or
+/// abort, exit 0, 1 or 2, and exit 0 only with finite printed numbers.
+#[test]
+fn shank_force_and_calibrate_numeric_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let (cols, _) = synthetic(15.0, 60.0, 15.0);
+    let rec = dir.path().join("rec.csv");
+    write_csv(&rec, &cols);
+    let cfg = config(dir.path(), "");
+    let mut stat = String::from("load_N,a_mm,xI_um,xII_um\n");
+    for f in [0.0, 25.0, 50.0, 75.0, 100.0] {
+        stat += &format!("{f},52,{},{}\n", 3.0 + 0.1 * f, 5.0 + 0.3 * f);
+    }
+    let static_rec = dir.path().join("static.csv");
+    fs::write(&static_rec, stat).unwrap();
+    let (rec, cfg, st) = (
+        rec.to_str().unwrap().to_string(),
+        cfg.to_str().unwrap().to_string(),
+        static_rec.to_str().unwrap().to_string(),
+    );
+    let special = [
+        "nan",
+        "inf",
+        "-inf",
+        "0",
+        "-1",
+        "1e308",
+        "-1e308",
+        "1e-308",
+        "18446744073709551616",
+    ];
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["shank", "force", &rec, "--config", &cfg],
+            "--sample-rate-hz",
+        ),
+        (
+            vec![
+                "shank",
+                "calibrate",
+                &st,
+                "--config",
+                &cfg,
+                "--force-channel",
+                "load_N",
+            ],
+            "--load-point-mm",
+        ),
+        (
+            vec![
+                "shank",
+                "calibrate",
+                &st,
+                "--config",
+                &cfg,
+                "--force-channel",
+                "load_N",
+                "--load-point-mm",
+                "52",
+            ],
+            "--sample-rate-hz",
+        ),
+    ];
+    for (base, flag) in cases {
+        for v in special {
+            let out = runout()
+                .args(&base)
+                .args([flag, v])
+                .timeout(std::time::Duration::from_secs(60))
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            let code = out.status.code();
+            assert!(
+                matches!(code, Some(0) | Some(1) | Some(2)),
+                "{base:?} {flag} {v}: {:?} {err}",
+                out.status
+            );
+            assert!(!err.contains("panicked"), "{flag} {v}: {err}");
+            if code == Some(0) {
+                let text = String::from_utf8_lossy(&out.stdout).to_lowercase();
+                assert!(
+                    !text.contains("nan") && !text.contains("inf"),
+                    "{flag} {v}: exit 0 with a non-finite number: {text}"
+                );
+            }
+        }
+    }
+}

@@ -121,11 +121,15 @@ impl ShankBeam {
                 l2,
             ));
         }
+        // the load must lie beyond sensor I: below it both sensors see only the rotation of the
+        // loaded end, δII − δI = a²(l2 − l1)/2EI → 0 and K_δ → ∞ (a = 1e-308 gave K_δ = inf)
         let a = self.load_distance_mm();
-        if !(a.is_finite() && a > 0.0 && a <= lt) {
+        if !(a.is_finite() && a > l1 && a <= lt) {
             return Err(ParamError::new(
                 "load_point_mm",
-                format!("a load point on the tool, 0 < a ≤ tool_length_mm = {lt}"),
+                format!(
+                    "a load point on the tool beyond sensor I, l1_mm = {l1} < a ≤ tool_length_mm = {lt}"
+                ),
                 a,
             ));
         }
