@@ -78,34 +78,71 @@ pub fn ensure_font() {
 macro_rules! render_plot {
     ($path:expr, $size:expr, $draw:expr) => {{
         use plotters::prelude::IntoDrawingArea;
-        let path: &std::path::Path = $path;
+        let final_path: &std::path::Path = $path;
         $crate::plot::ensure_font();
-        let p = path.display().to_string();
-        match $crate::plot::format_of(path)? {
+        let p = final_path.display().to_string();
+        let format = $crate::plot::format_of(final_path)?;
+        // drawn into a temporary file next to the destination (same extension: the bitmap
+        // backend picks the encoder by it) and renamed when complete: never half-written
+        let tmp = $crate::plot::partial_path(final_path);
+        let path: &std::path::Path = &tmp;
+        let drawn = match format {
             $crate::plot::Format::Svg => {
                 let root = plotters::prelude::SVGBackend::new(path, $size).into_drawing_area();
-                ($draw)(&root).map_err(|m: String| $crate::plot::PlotError::Draw {
-                    path: p.clone(),
-                    message: m,
-                })?;
-                root.present().map_err(|e| $crate::plot::PlotError::Draw {
-                    path: p.clone(),
-                    message: e.to_string(),
-                })
+                ($draw)(&root)
+                    .map_err(|m: String| $crate::plot::PlotError::Draw {
+                        path: p.clone(),
+                        message: m,
+                    })
+                    .and_then(|_| {
+                        root.present().map_err(|e| $crate::plot::PlotError::Draw {
+                            path: p.clone(),
+                            message: e.to_string(),
+                        })
+                    })
             }
             $crate::plot::Format::Png => {
                 let root = plotters::prelude::BitMapBackend::new(path, $size).into_drawing_area();
-                ($draw)(&root).map_err(|m: String| $crate::plot::PlotError::Draw {
-                    path: p.clone(),
-                    message: m,
-                })?;
-                root.present().map_err(|e| $crate::plot::PlotError::Draw {
+                ($draw)(&root)
+                    .map_err(|m: String| $crate::plot::PlotError::Draw {
+                        path: p.clone(),
+                        message: m,
+                    })
+                    .and_then(|_| {
+                        root.present().map_err(|e| $crate::plot::PlotError::Draw {
+                            path: p.clone(),
+                            message: e.to_string(),
+                        })
+                    })
+            }
+        };
+        match drawn {
+            Ok(()) => std::fs::rename(&tmp, final_path).map_err(|e| {
+                let _ = std::fs::remove_file(&tmp);
+                $crate::plot::PlotError::Draw {
                     path: p.clone(),
                     message: e.to_string(),
-                })
+                }
+            }),
+            Err(e) => {
+                let _ = std::fs::remove_file(&tmp);
+                Err(e)
             }
         }
     }};
+}
+
+/// Temporary file for drawing `path`: `.NAME.partial-PID.EXT` in the same folder.
+pub fn partial_path(path: &std::path::Path) -> std::path::PathBuf {
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = path
+        .extension()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!(".{stem}.partial-{}.{ext}", std::process::id()))
 }
 
 /// Stringify a plotters error.

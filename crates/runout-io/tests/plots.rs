@@ -189,3 +189,27 @@ fn waveform_predicted_traces_use_their_legend_colours() {
         "a predicted dash in another colour: {dashes:?}"
     );
 }
+
+/// Issue 20 item 3: a plot is drawn into a temporary file in the same folder and renamed when
+/// complete — the destination appears whole, and no temporary file is left behind.
+#[test]
+fn plots_are_written_whole_without_leftovers() {
+    let dir = tempfile::tempdir().unwrap();
+    for ext in ["svg", "png"] {
+        let dest = dir.path().join(format!("w.{ext}"));
+        let deg: Vec<f64> = (0..36).map(|i| i as f64 * 10.0).collect();
+        let v: Vec<f64> = deg.iter().map(|d| d.to_radians().sin()).collect();
+        let c = [runout_io::plot::identify::Curve {
+            label: "F_x (N)",
+            values: &v,
+        }];
+        runout_io::plot::identify::waveform_overlay(&dest, &deg, &c, &c, "t").unwrap();
+        assert!(std::fs::metadata(&dest).unwrap().len() > 0);
+    }
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names.len(), 2, "{names:?}");
+    assert!(names.iter().all(|n| !n.contains("partial")), "{names:?}");
+}
