@@ -785,34 +785,30 @@ fn resonance_from_the_cut_spectrum_is_reported() {
     );
 }
 
+/// A synthetic force recording, the test config and a static load table in `dir`, as paths.
+fn shank_inputs(dir: &Path) -> (String, String, String) {
+    let (cols, _) = synthetic(15.0, 60.0, 15.0);
+    let rec = dir.join("rec.csv");
+    write_csv(&rec, &cols);
+    let cfg = config(dir, "");
+    let mut stat = String::from("load_N,a_mm,xI_um,xII_um\n");
+    for f in [0.0, 25.0, 50.0, 75.0, 100.0] {
+        stat += &format!("{f},52,{},{}\n", 3.0 + 0.1 * f, 5.0 + 0.3 * f);
+    }
+    let st = dir.join("static.csv");
+    fs::write(&st, stat).unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    (s(&rec), s(&cfg), s(&st))
+}
+
 /// Issue 20 item 4 for the shank commands: with the reader gone at once (`| head -0`), `shank
 /// force` (text, `--json -`, `--out -`) and `shank calibrate` end quietly — status 0 or 141 (or
 /// SIGPIPE), no panic, no "Broken pipe" message.
 #[test]
 fn shank_force_and_calibrate_end_quietly_on_a_closed_pipe() {
-    use std::process::{Command as StdCommand, Stdio};
     let dir = tempfile::tempdir().unwrap();
-    let (cols, _) = synthetic(15.0, 60.0, 15.0);
-    let rec = dir.path().join("rec.csv");
-    write_csv(&rec, &cols);
-    let cfg = config(dir.path(), "");
-    let mut stat = String::from("load_N,a_mm,xI_um,xII_um\n");
-    for (i, f) in [0.0, 25.0, 50.0, 75.0, 100.0].iter().enumerate() {
-        for a in [40.0, 52.0, 64.0] {
-            stat += &format!(
-                "{f},{a},{},{}\n",
-                3.0 + 0.1 * f,
-                5.0 + 0.3 * f + 0.001 * i as f64
-            );
-        }
-    }
-    let static_rec = dir.path().join("static.csv");
-    fs::write(&static_rec, stat).unwrap();
-    let (rec, cfg, st) = (
-        rec.to_str().unwrap(),
-        cfg.to_str().unwrap(),
-        static_rec.to_str().unwrap(),
-    );
+    let (rec, cfg, st) = shank_inputs(dir.path());
+    let (rec, cfg, st) = (rec.as_str(), cfg.as_str(), st.as_str());
     let cases: [Vec<&str>; 4] = [
         vec!["shank", "force", rec, "--config", cfg],
         vec!["shank", "force", rec, "--config", cfg, "--json", "-"],
@@ -830,32 +826,7 @@ fn shank_force_and_calibrate_end_quietly_on_a_closed_pipe() {
         ],
     ];
     for args in cases {
-        let mut child = StdCommand::new(assert_cmd::cargo::cargo_bin("runout"))
-            .args(&args)
-            .env("RUST_BACKTRACE", "0")
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        drop(child.stdout.take());
-        let out = child.wait_with_output().unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
-        #[cfg(unix)]
-        let sigpipe = {
-            use std::os::unix::process::ExitStatusExt;
-            out.status.signal() == Some(13)
-        };
-        #[cfg(not(unix))]
-        let sigpipe = false;
-        assert!(
-            out.status.success() || sigpipe || out.status.code() == Some(141),
-            "{args:?}: {:?} {err}",
-            out.status
-        );
-        assert!(
-            !err.contains("panicked") && !err.contains("Broken pipe"),
-            "{args:?}: {err}"
-        );
+        closed_pipe(&args);
     }
 }
 
@@ -865,21 +836,7 @@ fn shank_force_and_calibrate_end_quietly_on_a_closed_pipe() {
 #[test]
 fn shank_force_and_calibrate_numeric_flags() {
     let dir = tempfile::tempdir().unwrap();
-    let (cols, _) = synthetic(15.0, 60.0, 15.0);
-    let rec = dir.path().join("rec.csv");
-    write_csv(&rec, &cols);
-    let cfg = config(dir.path(), "");
-    let mut stat = String::from("load_N,a_mm,xI_um,xII_um\n");
-    for f in [0.0, 25.0, 50.0, 75.0, 100.0] {
-        stat += &format!("{f},52,{},{}\n", 3.0 + 0.1 * f, 5.0 + 0.3 * f);
-    }
-    let static_rec = dir.path().join("static.csv");
-    fs::write(&static_rec, stat).unwrap();
-    let (rec, cfg, st) = (
-        rec.to_str().unwrap().to_string(),
-        cfg.to_str().unwrap().to_string(),
-        static_rec.to_str().unwrap().to_string(),
-    );
+    let (rec, cfg, st) = shank_inputs(dir.path());
     let special = [
         "nan",
         "inf",

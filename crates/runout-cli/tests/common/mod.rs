@@ -43,3 +43,35 @@ pub const SEED003_COEFFICIENTS: [&str; 12] = [
     "--ktc", "1889.2", "--krc", "806.1", "--kac", "291", "--kte", "63.12", "--kre", "113.7",
     "--kae", "-3.1",
 ];
+
+/// Run `runout ARGS` with its reader gone at once (as with `| head -0`): it must end quietly —
+/// status 0 or 141 (or killed by SIGPIPE), no panic, no "Broken pipe" message (issue 20 item 4).
+pub fn closed_pipe<S: AsRef<std::ffi::OsStr> + std::fmt::Debug>(args: &[S]) {
+    use std::process::{Command as StdCommand, Stdio};
+    let mut child = StdCommand::new(assert_cmd::cargo::cargo_bin("runout"))
+        .args(args)
+        .env("RUST_BACKTRACE", "0")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    #[cfg(unix)]
+    let killed_by_sigpipe = {
+        use std::os::unix::process::ExitStatusExt;
+        out.status.signal() == Some(13)
+    };
+    #[cfg(not(unix))]
+    let killed_by_sigpipe = false;
+    assert!(
+        out.status.success() || killed_by_sigpipe || out.status.code() == Some(141),
+        "{args:?}: {:?} {err}",
+        out.status
+    );
+    assert!(
+        !err.contains("panicked") && !err.contains("Broken pipe"),
+        "{args:?}: {err}"
+    );
+}
