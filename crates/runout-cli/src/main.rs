@@ -10,7 +10,7 @@ use std::process::ExitCode;
 /// Cutter runout in milling: simulate, identify, compensate.
 ///
 /// Units: lengths mm (runout µm), forces N, time s, angles deg, speed rpm. Conventions:
-/// shared/spec/conventions.md (teeth in cutting order, runout angle from tooth 0 in the
+/// docs/conventions.md (teeth in cutting order, runout angle from tooth 0 in the
 /// direction of rotation, forces acting on the workpiece).
 #[derive(Parser, Debug)]
 #[command(name = "runout", version, about, long_about = None)]

@@ -1,5 +1,5 @@
 //! Angle helpers. Inside the library angles are radians; degrees only at the interface
-//! (`../shared/spec/conventions.md`, "Units").
+//! (`docs/conventions.md`, "Units").
 
 use std::f64::consts::TAU;
 

@@ -4,7 +4,7 @@
 //! methods built on it. No file I/O: readers and writers live in `runout-io`, the command line in
 //! `runout-cli`.
 //!
-//! Units and conventions are those of `shared/spec/conventions.md`: lengths in mm, forces in N,
+//! Units and conventions are those of `docs/conventions.md`: lengths in mm, forces in N,
 //! time in s, angles in **radians** inside the library, tooth numbering in cutting order, runout
 //! e = ρ·(cos λ, sin λ) measured from tooth 0 in the direction of rotation.
 //!

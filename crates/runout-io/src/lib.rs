@@ -2,7 +2,7 @@
 //!
 //! Readers and writers for `runout`: configuration files with units, recordings, toolpaths,
 //! result tables and plots. All conversion to the library's conventions
-//! (`shared/spec/conventions.md`) happens here, at the boundary.
+//! (`docs/conventions.md`) happens here, at the boundary.
 #![warn(missing_docs)]
 
 pub mod config;
