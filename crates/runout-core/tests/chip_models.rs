@@ -659,3 +659,103 @@ fn newton_stopping_rule_accepts_only_converged_iterates() {
         assert!(worst <= 1e-12, "R {} ρ {rho}: {worst:e}", cutter.radius());
     }
 }
+
+/// The incremental poses of [`RigidStep`] (used by the exact solver's look-back) equal the
+/// motion's own poses to rounding: |ΔP| ≤ 1e-12 mm and |Δu|, |Δe₁| ≤ 1e-14 over a look-back of up
+/// to one revolution (10 ms at 6000 rpm), on a swing about a pivot and across the junctions of a
+/// CL path (where the step must decline and the solver falls back to `pose`).
+#[test]
+fn rigid_step_poses_equal_direct_poses() {
+    let swing = ConstantSwing::new(
+        Vec3::new(40.0, 3.0, -1.0),
+        Vec3::new(0.2, 1.0, 0.1),
+        1.3,
+        25.0,
+    )
+    .unwrap();
+    let pts: Vec<ClPoint> = (0..12)
+        .map(|n| {
+            let a = (2.0 * n as f64).to_radians();
+            ClPoint {
+                p: Vec3::new(n as f64 * 0.3, 0.01 * (n as f64).powi(2), 0.0),
+                u: Vec3::new(a.sin(), 0.1 * a.sin(), a.cos()).normalize(),
+                feed: 40.0,
+            }
+        })
+        .collect();
+    let path = ClPath::new(&pts).unwrap();
+    assert_eq!(rigid_step_mismatches("swing", &swing), 0);
+    let declined = rigid_step_mismatches("path", &path);
+    assert!(
+        declined > 0,
+        "the CL path's junctions must make the step decline"
+    );
+}
+
+/// Compares `pose_at` with `pose` over look-backs of up to 10 ms; returns how often the step
+/// declined (outside its screw interval).
+fn rigid_step_mismatches<M: ToolMotion>(name: &str, motion: &M) -> usize {
+    let mut declined = 0;
+    for q in 0..200 {
+        let t = 0.002 + 0.0004 * q as f64;
+        let step = motion.rigid_step(t).expect("a constant screw");
+        assert_eq!(step.pose, motion.pose(t), "{name}: the step's own pose");
+        for j in 0..=20 {
+            let t2 = t - 0.0005 * j as f64;
+            let direct = motion.pose(t2);
+            match step.pose_at(t2) {
+                Some(p) => {
+                    assert!((p.p - direct.p).norm() <= 1e-12, "{name} t {t} → {t2}: P");
+                    assert!((p.u - direct.u).norm() <= 1e-14, "{name}: u");
+                    assert!((p.e1 - direct.e1).norm() <= 1e-14, "{name}: e1");
+                    assert!((p.v - direct.v).norm() <= 1e-11, "{name}: v");
+                    assert!((p.w - direct.w).norm() <= 1e-15, "{name}: w");
+                }
+                None => declined += 1,
+            }
+        }
+    }
+    declined
+}
+
+/// `spindle_point_near` (series rotation from the prepared height) equals `spindle_point`.
+#[test]
+fn spindle_point_near_equals_spindle_point() {
+    for profile in [
+        RadiusProfile::Flat,
+        RadiusProfile::Ball,
+        RadiusProfile::BullNose { corner_mm: 1.5 },
+    ] {
+        let cutter = Cutter::new(
+            10.0,
+            vec![1.4, 1.7, 1.5, TAU - 4.6],
+            35.0,
+            30.0,
+            profile.clone(),
+        )
+        .unwrap();
+        let runout = Runout::new(0.012, 0.7)
+            .unwrap()
+            .with_tilt_vector([2e-4, -1e-4]);
+        let kin = straight_kin(&cutter, &runout, 0.1);
+        for z in [0.3, 2.0, 5.0] {
+            let geo = kin.at_height(z);
+            for tooth in 0..4 {
+                for dz in [-0.2, -1e-3, 1e-6, 0.05, 0.3] {
+                    let a = kin.spindle_point(tooth, z + dz);
+                    let b = kin.spindle_point_near(&geo, tooth, z + dz);
+                    for c in 0..2 {
+                        assert!(
+                            (a.xy[c] - b.xy[c]).abs() <= 1e-13,
+                            "{profile:?} z {z} dz {dz}"
+                        );
+                        assert!(
+                            (a.dxy[c] - b.dxy[c]).abs() <= 1e-12,
+                            "{profile:?} z {z} dz {dz}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

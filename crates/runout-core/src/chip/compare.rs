@@ -7,7 +7,7 @@
 use super::closed_form::{arc_at, closed_forms_at, equivalent_at, EquivalentParams};
 use super::exact::{exact_at, NewtonOptions};
 use super::kinematics::{
-    CircularFeed, ClPath, ConstantSwing, HeightGeometry, JointPath, Pose, StraightFeed,
+    CircularFeed, ClPath, ConstantSwing, HeightGeometry, JointPath, Pose, RigidStep, StraightFeed,
     ToolKinematics, ToolMotion,
 };
 use super::lookback::EquivalentEvaluator;
@@ -36,6 +36,16 @@ impl ToolMotion for Motion {
             Motion::Swing(m) => m.pose(t),
             Motion::Path(m) => m.pose(t),
             Motion::Joints(m) => m.pose(t),
+        }
+    }
+    #[inline]
+    fn rigid_step(&self, t: f64) -> Option<RigidStep> {
+        match self {
+            Motion::Straight(m) => m.rigid_step(t),
+            Motion::Circular(m) => m.rigid_step(t),
+            Motion::Swing(m) => m.rigid_step(t),
+            Motion::Path(m) => m.rigid_step(t),
+            Motion::Joints(m) => m.rigid_step(t),
         }
     }
     fn smooth_on(&self, t0: f64, t1: f64) -> bool {

@@ -48,6 +48,125 @@ pub trait ToolMotion: Send + Sync {
     fn smooth_on(&self, _t0: f64, _t1: f64) -> bool {
         false
     }
+
+    /// The motion around time `t` as a [`RigidStep`] (pose at `t` plus the screw that moves it),
+    /// for motions that are a rigid rotation at constant angular velocity about a point moving at
+    /// constant velocity on an interval containing `t`. Solvers then reach nearby times by an
+    /// incremental rotation instead of re-evaluating [`Self::pose`]. Default: `None`.
+    fn rigid_step(&self, _t: f64) -> Option<RigidStep> {
+        None
+    }
+}
+
+/// A constant screw motion of the tool frame around a reference time: on [lo, hi) the frame turns
+/// at constant angular velocity Ω = rate·ŵ and the point C = P + pivot·u moves at constant
+/// velocity v_c, so that for t = t_r + δ
+///
+/// frame(t) = Rot(ŵ, rate·δ)·frame(t_r),   P(t) = P(t_r) + v_c·δ + pivot·(u(t_r) − u(t)),
+/// Ṗ(t) = v_c − pivot·Ω×u(t)
+///
+/// (exact for [`StraightFeed`], [`ConstantSwing`] and each segment of a [`ClPath`]). The rotation
+/// by a small angle uses [`small_sin_cos`]: no libm call, same result as [`ToolMotion::pose`] to
+/// rounding (|δP| ~ 1e-14 mm on the benchmark paths, tested in `tests/chip_models.rs`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidStep {
+    /// Reference time t_r (s).
+    pub t: f64,
+    /// Pose at t_r.
+    pub pose: Pose,
+    lo: f64,
+    hi: f64,
+    /// Rodrigues terms of u and e₁ (v ↦ v + sin α·ŵ×v + (1 − cos α)·(ŵ(ŵ·v) − v)), precomputed:
+    /// [ŵ×u, ŵ(ŵ·u) − u, ŵ×e₁, ŵ(ŵ·e₁) − e₁].
+    terms: [Vec3; 4],
+    /// Rotation rate (rad/s).
+    rate: f64,
+    /// Height of the point C above the tip (mm).
+    pivot: f64,
+    /// Velocity of C (mm/s).
+    vc: Vec3,
+}
+
+impl RigidStep {
+    /// The screw about unit `axis` at `rate` through the point `pivot` above the tip, whose
+    /// velocity is `vc`, valid on [lo, hi), seen from `pose` at time `t`.
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        t: f64,
+        pose: Pose,
+        lo: f64,
+        hi: f64,
+        axis: Vec3,
+        rate: f64,
+        pivot: f64,
+        vc: Vec3,
+    ) -> Self {
+        let terms = [
+            axis.cross(&pose.u),
+            axis * axis.dot(&pose.u) - pose.u,
+            axis.cross(&pose.e1),
+            axis * axis.dot(&pose.e1) - pose.e1,
+        ];
+        RigidStep {
+            t,
+            pose,
+            lo,
+            hi,
+            terms,
+            rate,
+            pivot,
+            vc,
+        }
+    }
+
+    /// Largest rotation (rad) reached incrementally; beyond it [`Self::pose_at`] declines.
+    const MAX_ANGLE: f64 = 0.5;
+
+    /// Whether `t` lies in the interval of this screw (no CL-path junction in between).
+    #[inline]
+    pub fn covers(&self, t: f64) -> bool {
+        t >= self.lo && t < self.hi
+    }
+
+    /// Pose at time `t`, or `None` when `t` is outside the interval of this screw (a CL-path
+    /// junction) or the rotation is too large for the small-angle series.
+    #[inline]
+    pub fn pose_at(&self, t: f64) -> Option<Pose> {
+        if !self.covers(t) {
+            return None;
+        }
+        let dt = t - self.t;
+        let angle = self.rate * dt;
+        if angle.abs() > Self::MAX_ANGLE {
+            return None;
+        }
+        let (s, c) = small_sin_cos(angle);
+        let [cu, pu, ce, pe] = &self.terms;
+        let u = self.pose.u + cu * s + pu * (1.0 - c);
+        let e1 = self.pose.e1 + ce * s + pe * (1.0 - c);
+        let (p, v) = if self.pivot == 0.0 {
+            (self.pose.p + self.vc * dt, self.vc)
+        } else {
+            (
+                self.pose.p + self.vc * dt + (self.pose.u - u) * self.pivot,
+                self.vc - self.pose.w.cross(&u) * self.pivot,
+            )
+        };
+        Some(Pose {
+            p,
+            u,
+            e1,
+            v,
+            w: self.pose.w,
+        })
+    }
+}
+
+/// Pose at `t` from `step` when it applies there, else from the motion itself.
+#[inline]
+pub fn pose_near<M: ToolMotion>(motion: &M, step: Option<&RigidStep>, t: f64) -> Pose {
+    step.and_then(|s| s.pose_at(t))
+        .unwrap_or_else(|| motion.pose(t))
 }
 
 /// Rodrigues rotation of `v` about unit axis `w` by the angle with sine `s` and cosine `c`.
@@ -226,6 +345,18 @@ impl ToolMotion for ConstantSwing {
             w,
         }
     }
+    fn rigid_step(&self, t: f64) -> Option<RigidStep> {
+        Some(RigidStep::new(
+            t,
+            self.pose(t),
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            self.axis,
+            self.rate,
+            self.pivot,
+            self.v,
+        ))
+    }
 }
 
 /// One cutter-location point of a CL path (tool tip, axis, feed to reach the next point).
@@ -402,6 +533,27 @@ impl ToolMotion for ClPath {
             v: seg.dp / seg.dt,
             w: seg.w * (seg.angle / seg.dt),
         }
+    }
+    fn rigid_step(&self, t: f64) -> Option<RigidStep> {
+        // the first and last segments are extrapolated beyond the path (see `pose`)
+        let n = self.segment_index(t);
+        let seg = &self.segments[n];
+        let lo = if n == 0 { f64::NEG_INFINITY } else { seg.t0 };
+        let hi = if n + 1 == self.segments.len() {
+            f64::INFINITY
+        } else {
+            self.segments[n + 1].t0
+        };
+        Some(RigidStep::new(
+            t,
+            self.pose(t),
+            lo,
+            hi,
+            seg.w,
+            seg.angle / seg.dt,
+            0.0,
+            seg.dp / seg.dt,
+        ))
     }
 }
 
@@ -608,6 +760,8 @@ pub struct ToolKinematics<M> {
     motion: M,
     /// Spindle time between the passes of tooth i−m and tooth i: `gap_time[i*K + m−1]` (s).
     gap_time: Vec<f64>,
+    /// Runout vector e₀ at the tip (mm).
+    offset0: [f64; 2],
 }
 
 impl<M: ToolMotion> ToolKinematics<M> {
@@ -637,6 +791,7 @@ impl<M: ToolMotion> ToolKinematics<M> {
             sense,
             motion,
             gap_time,
+            offset0: runout.vector_at(0.0),
         })
     }
 
@@ -691,12 +846,32 @@ impl<M: ToolMotion> ToolKinematics<M> {
     #[inline]
     pub fn spindle_point(&self, tooth: usize, z: f64) -> SpindlePoint {
         let psi = self.cutter.tooth_angle(tooth, z);
-        let (s, c) = psi.sin_cos();
+        self.spindle_point_sc(psi.sin_cos(), z)
+    }
+
+    /// [`Self::spindle_point`] of `tooth` at a height `z` near the prepared height `geo.z`
+    /// (a Newton iterate z′): the edge direction u(ψ_i(z′)) is u(ψ_i(z)) turned by the small
+    /// angle ψ_i(z′) − ψ_i(z) (series sin/cos, no libm call; same value to rounding).
+    #[inline]
+    pub fn spindle_point_near(&self, geo: &HeightGeometry, tooth: usize, z: f64) -> SpindlePoint {
+        let turn = self.cutter.tooth_angle(tooth, z) - self.cutter.tooth_angle(tooth, geo.z);
+        if turn.abs() > 0.5 {
+            return self.spindle_point(tooth, z);
+        }
+        let (st, ct) = small_sin_cos(turn);
+        let (s0, c0) = geo.direction[tooth];
+        self.spindle_point_sc((s0 * ct + c0 * st, c0 * ct - s0 * st), z)
+    }
+
+    /// Spindle-frame edge point at height `z` whose nominal edge direction is (sin ψ, cos ψ).
+    #[inline]
+    fn spindle_point_sc(&self, (s, c): (f64, f64), z: f64) -> SpindlePoint {
         let r = self.cutter.radius_at(z);
         let dr = radius_slope(&self.cutter, z);
         let dpsi = -self.cutter.tan_helix() / self.cutter.radius();
-        let e = self.runout.vector_at(z);
+        // e(z) = e₀ + z·τ with e₀ cached (Runout::vector_at would take a libm sin_cos per call)
         let tau = self.runout.tilt();
+        let e = [self.offset0[0] + z * tau[0], self.offset0[1] + z * tau[1]];
         SpindlePoint {
             xy: [r * c + e[0], r * s + e[1]],
             dxy: [
@@ -783,6 +958,8 @@ pub struct HeightGeometry {
     k: usize,
     /// Spindle-frame edge point per tooth.
     pub points: Vec<SpindlePoint>,
+    /// (sin ψ_i(z), cos ψ_i(z)) of the nominal edge direction per tooth.
+    pub direction: Vec<(f64, f64)>,
     /// Effective radius R_i(z) per tooth (mm), eq. (0.1).
     pub radius: Vec<f64>,
     /// Effective edge angle ψ_i + δ_i per tooth (rad), eq. (0.2).
@@ -818,7 +995,13 @@ impl<M: ToolMotion> ToolKinematics<M> {
     /// Precompute the height-dependent geometry at `z`.
     pub fn at_height(&self, z: f64) -> HeightGeometry {
         let k = self.cutter.teeth();
-        let points: Vec<SpindlePoint> = (0..k).map(|i| self.spindle_point(i, z)).collect();
+        let direction: Vec<(f64, f64)> = (0..k)
+            .map(|i| self.cutter.tooth_angle(i, z).sin_cos())
+            .collect();
+        let points: Vec<SpindlePoint> = direction
+            .iter()
+            .map(|&sc| self.spindle_point_sc(sc, z))
+            .collect();
         let radius: Vec<f64> = points.iter().map(SpindlePoint::radius).collect();
         let phase: Vec<f64> = points.iter().map(SpindlePoint::angle).collect();
         let mut tau_nominal = Vec::with_capacity(k * k);
@@ -845,6 +1028,7 @@ impl<M: ToolMotion> ToolKinematics<M> {
             z,
             k,
             points,
+            direction,
             radius,
             phase,
             tau_nominal,

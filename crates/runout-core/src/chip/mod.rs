@@ -27,7 +27,7 @@ pub use exact::{
 };
 pub use kinematics::{
     CircularFeed, ClPath, ClPoint, ConstantSwing, EdgeState, HeightGeometry, JointPath, JointPoint,
-    Pose, SpindlePoint, SpindleSense, StraightFeed, ToolKinematics, ToolMotion, Vec3,
+    Pose, RigidStep, SpindlePoint, SpindleSense, StraightFeed, ToolKinematics, ToolMotion, Vec3,
 };
 pub use lookback::{EquivalentEvaluator, HeightLookBack, LookBack};
 pub use straight::{
