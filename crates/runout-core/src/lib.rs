@@ -30,6 +30,7 @@ pub mod force;
 pub mod grind;
 pub mod identify;
 pub mod limits;
+pub mod plausibility;
 pub mod runout;
 pub mod shank;
 pub mod signal;

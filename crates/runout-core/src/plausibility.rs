@@ -1,0 +1,371 @@
+//! Plausibility guards: checks of an identified result (or of the data behind it) against what
+//! physics and published data allow, each returning a [`Finding`] in the user's words with what
+//! to check. A finding of severity [`Severity::NotIdentified`] means the value must not be used:
+//! reports mark the quantity as not identified and say why.
+//!
+//! The thresholds and their sources:
+//!
+//! - **Runout** (`runout_size`): runouts of end mills in holders are typically 2–20 µm and rarely
+//!   above 50 µm (docs/methods.md §6.3); a runout above 5 % of the cutter radius or 0.2 mm is
+//!   not a holder error but a wrong model (diameter, profile, depth) or wrong data. A runout above
+//!   the feed per tooth is physically possible, but then a tooth loses contact every revolution,
+//!   which the user should know (warning).
+//! - **Cutting coefficients** (`coefficients`): the linear (mechanistic) tangential shear
+//!   coefficient K_tc of metals lies in 200–8 000 N/mm² — specific cutting forces k_c1 of
+//!   500–3 100 N/mm² at h = 1 mm for the ISO material groups P, M, K, N, S, H (Sandvik Coromant,
+//!   "specific cutting force" tables), rising as h^−0.25 towards the thin chips of milling
+//!   (Kienzle), with margin. The radial shear and both tangential and radial edge coefficients are
+//!   positive (the tool pushes the chip away and rubs the surface); K_rc ≤ 1.5·K_tc; edge
+//!   coefficients below 300 N/mm. Axial coefficients may be negative (published fits with helical
+//!   cutters have both signs) but |K_ac| ≤ K_tc, |K_ae| ≤ 100 N/mm. A value is judged with its
+//!   standard error: implausible only when the whole ±2·SE interval is outside the range.
+//! - **Clipping** (`ClipDetector`): an amplifier or ADC at its range limit produces flat tops —
+//!   runs of equal samples at the channel's extreme.
+//! - **Same data twice** (`duplicates`): identical sample content under two names.
+//! - **Sensor senses** (`sensor_senses`): two displacement sensors on one shank see the same
+//!   deflection with the same sign (the shank bends as a whole); a negative correlation of their
+//!   variations means one sensor's sense or axis is reversed.
+
+use crate::coefficients::CuttingCoefficients;
+
+/// How serious a finding is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Severity {
+    /// The value can be used, but the user should know.
+    Warning,
+    /// The value must not be used: report it as not identified.
+    NotIdentified,
+}
+
+/// One plausibility finding.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Finding {
+    /// Stable machine-readable code (e.g. `runout_too_large`).
+    pub code: &'static str,
+    /// Which quantity it concerns (e.g. `runout`, `K_tc`, a channel or file name).
+    pub subject: String,
+    /// What is wrong, in words, with the numbers.
+    pub message: String,
+    /// What the user can check or do.
+    pub hint: String,
+    /// Severity.
+    pub severity: Severity,
+}
+
+impl std::fmt::Display for Finding {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.message, self.hint)
+    }
+}
+
+/// Largest plausible runout as a fraction of the cutter radius.
+pub const MAX_RUNOUT_FRACTION_OF_RADIUS: f64 = 0.05;
+/// Largest plausible runout (mm).
+pub const MAX_RUNOUT_MM: f64 = 0.2;
+
+/// Check an identified runout ρ (mm) against the cutter radius R (mm) and the feed per tooth
+/// f_z (mm).
+///
+/// ```
+/// use runout_core::plausibility::{runout_size, Severity};
+/// assert!(runout_size(0.008, 5.0, 0.08).is_empty());
+/// let f = runout_size(1.495, 5.0, 0.08);
+/// assert_eq!(f[0].severity, Severity::NotIdentified);
+/// ```
+pub fn runout_size(rho_mm: f64, radius_mm: f64, fz_mm: f64) -> Vec<Finding> {
+    let mut out = Vec::new();
+    let limit = (MAX_RUNOUT_FRACTION_OF_RADIUS * radius_mm).min(MAX_RUNOUT_MM);
+    if !rho_mm.is_finite() || rho_mm > limit {
+        out.push(Finding {
+            code: "runout_too_large",
+            subject: "runout".into(),
+            message: format!(
+                "runout ρ = {:.1} µm is implausible for a cutter of radius {radius_mm} mm \
+                 (holder runouts are 2–20 µm, rarely above 50; limit {:.0} µm)",
+                rho_mm * 1e3,
+                limit * 1e3
+            ),
+            hint: "check the cutter description (diameter, profile: a ball or bull-nose cutter \
+                   described as flat gives such values), the axial depth and the axis mapping"
+                .into(),
+            severity: Severity::NotIdentified,
+        });
+    } else if fz_mm > 0.0 && rho_mm > fz_mm {
+        out.push(Finding {
+            code: "runout_exceeds_feed",
+            subject: "runout".into(),
+            message: format!(
+                "runout ρ = {:.1} µm exceeds the feed per tooth f_z = {:.1} µm: the shortest \
+                 tooth cuts little or nothing",
+                rho_mm * 1e3,
+                fz_mm * 1e3
+            ),
+            hint: "re-clamp the tool or use a holder with less runout; the per-tooth loads are \
+                   very unequal at this feed"
+                .into(),
+            severity: Severity::Warning,
+        });
+    }
+    out
+}
+
+/// Plausible range of each coefficient `[K_tc, K_rc, K_ac, K_te, K_re, K_ae]` given K_tc
+/// (module docs). Returns (low, high) in N/mm² or N/mm.
+fn coefficient_range(index: usize, ktc: f64) -> (f64, f64) {
+    match index {
+        0 => (200.0, 8000.0),
+        1 => (0.0, 1.5 * ktc.max(200.0)),
+        2 => (-ktc.abs().max(200.0), ktc.abs().max(200.0)),
+        3 | 4 => (0.0, 300.0),
+        _ => (-100.0, 100.0),
+    }
+}
+
+/// Names and units of the six coefficients, in `to_array` order.
+pub const COEFFICIENT_NAMES: [(&str, &str); 6] = [
+    ("K_tc", "N/mm²"),
+    ("K_rc", "N/mm²"),
+    ("K_ac", "N/mm²"),
+    ("K_te", "N/mm"),
+    ("K_re", "N/mm"),
+    ("K_ae", "N/mm"),
+];
+
+/// Check identified coefficients (with their standard errors, if known) against the ranges
+/// published for metals (module docs). A coefficient is implausible when its whole
+/// value ± 2·SE interval lies outside the range.
+///
+/// ```
+/// use runout_core::CuttingCoefficients;
+/// use runout_core::plausibility::coefficients;
+/// let k = CuttingCoefficients::new([1889.2, 806.1, 291.0], [63.12, 113.7, -3.1]).unwrap();
+/// assert!(coefficients(&k, None).is_empty());
+/// let bad = CuttingCoefficients::new([1889.2, 806.1, 291.0], [-20.0, 113.7, -3.1]).unwrap();
+/// assert_eq!(coefficients(&bad, Some([1.0; 6]))[0].subject, "K_te");
+/// ```
+pub fn coefficients(k: &CuttingCoefficients, se: Option<[f64; 6]>) -> Vec<Finding> {
+    let v = k.to_array();
+    let se = se.unwrap_or([0.0; 6]);
+    let mut out = Vec::new();
+    for (i, (&value, &s)) in v.iter().zip(&se).enumerate() {
+        let (lo, hi) = coefficient_range(i, k.ktc);
+        let s = if s.is_finite() { s.abs() } else { 0.0 };
+        let (name, unit) = COEFFICIENT_NAMES[i];
+        if !value.is_finite() || value + 2.0 * s < lo || value - 2.0 * s > hi {
+            let sign = if value < 0.0 && lo >= 0.0 {
+                "negative, which no metal cutting gives"
+            } else {
+                "outside the range published for metals"
+            };
+            out.push(Finding {
+                code: "coefficient_implausible",
+                subject: name.into(),
+                message: format!(
+                    "{name} = {value:.1} ± {s:.1} {unit} is {sign} ({lo:.0} to {hi:.0} {unit})"
+                ),
+                hint: "check the cutter diameter, the depths of cut, the feed per tooth and the \
+                       force units; with one feed only the edge and shear terms are not separable"
+                    .into(),
+                severity: Severity::NotIdentified,
+            });
+        }
+    }
+    out
+}
+
+/// One side (maximum or minimum) of a [`ClipDetector`].
+#[derive(Debug, Clone, Copy, Default)]
+struct Extreme {
+    value: f64,
+    /// Length of the current run of samples equal to `value`.
+    run: usize,
+    /// Completed-or-current runs of at least `MIN_RUN` samples at `value`, and their samples.
+    flat_runs: usize,
+    flat_samples: usize,
+}
+
+impl Extreme {
+    /// Take sample `v`; `beyond` tells whether v is a new extreme (above the max / below the min).
+    #[inline]
+    fn push(&mut self, v: f64, beyond: bool) {
+        if beyond {
+            // an earlier flat run was not at the limit after all
+            *self = Extreme {
+                value: v,
+                run: 1,
+                ..Default::default()
+            };
+        } else if v == self.value {
+            self.run += 1;
+            if self.run == ClipDetector::MIN_RUN {
+                self.flat_runs += 1;
+                self.flat_samples += ClipDetector::MIN_RUN;
+            } else if self.run > ClipDetector::MIN_RUN {
+                self.flat_samples += 1;
+            }
+        } else {
+            self.run = 0;
+        }
+    }
+}
+
+/// Streaming detector of clipped channels. An amplifier or ADC at its range limit cuts every
+/// peak that exceeds it, so the channel shows **several separate runs** of at least `MIN_RUN`
+/// equal samples at its extreme. One run alone is not enough: a slowly varying quantised signal
+/// (drift, an air cut) can sit on its largest code for a few samples once.
+#[derive(Debug, Clone)]
+pub struct ClipDetector {
+    max: Extreme,
+    min: Extreme,
+    samples: usize,
+}
+
+impl Default for ClipDetector {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl ClipDetector {
+    /// Consecutive equal samples at the extreme that make a flat top.
+    pub const MIN_RUN: usize = 3;
+    /// Separate flat tops needed to call the channel clipped.
+    pub const MIN_RUNS: usize = 3;
+
+    /// A detector that has seen nothing.
+    pub fn new() -> Self {
+        ClipDetector {
+            max: Extreme {
+                value: f64::NEG_INFINITY,
+                ..Default::default()
+            },
+            min: Extreme {
+                value: f64::INFINITY,
+                ..Default::default()
+            },
+            samples: 0,
+        }
+    }
+
+    /// Feed samples (non-finite ones are ignored).
+    pub fn push(&mut self, values: &[f64]) {
+        for &v in values.iter().filter(|v| v.is_finite()) {
+            self.samples += 1;
+            let above = v > self.max.value;
+            self.max.push(v, above);
+            let below = v < self.min.value;
+            self.min.push(v, below);
+        }
+    }
+
+    /// The finding for channel `name` (unit `unit`), if it clipped.
+    ///
+    /// ```
+    /// use runout_core::plausibility::ClipDetector;
+    /// let sine: Vec<f64> = (0..5000).map(|q| 100.0 * (q as f64 * 0.05).sin()).collect();
+    /// let mut ok = ClipDetector::new();
+    /// ok.push(&sine);
+    /// assert!(ok.finding("Fx", "N").is_none());
+    /// let clipped: Vec<f64> = sine.iter().map(|v| v.clamp(-80.0, 80.0)).collect();
+    /// let mut bad = ClipDetector::new();
+    /// bad.push(&clipped);
+    /// assert!(bad.finding("Fx", "N").is_some());
+    /// ```
+    pub fn finding(&self, name: &str, unit: &str) -> Option<Finding> {
+        let top = self.max.flat_runs >= Self::MIN_RUNS;
+        let bottom = self.min.flat_runs >= Self::MIN_RUNS;
+        if !(top || bottom) || self.max.value == self.min.value {
+            return None;
+        }
+        let (flat, at) = match (top, bottom) {
+            (true, true) => (
+                self.max.flat_samples + self.min.flat_samples,
+                format!("{} and {} {unit}", self.min.value, self.max.value),
+            ),
+            (true, false) => (self.max.flat_samples, format!("{} {unit}", self.max.value)),
+            _ => (self.min.flat_samples, format!("{} {unit}", self.min.value)),
+        };
+        Some(Finding {
+            code: "channel_clipped",
+            subject: name.into(),
+            message: format!(
+                "channel {name} is clipped: {flat} of {} samples sit flat at its extreme {at}",
+                self.samples
+            ),
+            hint: "the amplifier or data-acquisition range was exceeded: re-record with a larger \
+                   range; peaks and fits from clipped data are too low"
+                .into(),
+            severity: Severity::NotIdentified,
+        })
+    }
+}
+
+/// Findings for recordings with identical sample content: `items` are (name, content hash) pairs,
+/// the hash over the samples only (not the header or the name).
+pub fn duplicates(items: &[(String, u64)]) -> Vec<Finding> {
+    let mut out = Vec::new();
+    for (j, (name, hash)) in items.iter().enumerate() {
+        if let Some((first, _)) = items[..j].iter().find(|(_, h)| h == hash) {
+            out.push(Finding {
+                code: "same_data_twice",
+                subject: name.clone(),
+                message: format!("{name} holds the same samples as {first}"),
+                hint: "the same recording was passed twice (perhaps under another name): each \
+                       feed needs its own recording"
+                    .into(),
+                severity: Severity::NotIdentified,
+            });
+        }
+    }
+    out
+}
+
+/// Check that two displacement sensors on one shank see the same deflection with the same sign:
+/// the correlation coefficient of their mean-removed signals must be positive. `a` and `b` are
+/// simultaneous samples of the same axis (sensor I and sensor II); `axis` names it.
+///
+/// ```
+/// use runout_core::plausibility::sensor_senses;
+/// let a: Vec<f64> = (0..400).map(|q| (q as f64 * 0.1).sin()).collect();
+/// let b: Vec<f64> = a.iter().map(|v| 0.4 * v + 0.01).collect();
+/// assert!(sensor_senses(&a, &b, "x").is_none());
+/// let flipped: Vec<f64> = b.iter().map(|v| -v).collect();
+/// assert!(sensor_senses(&a, &flipped, "x").is_some());
+/// ```
+pub fn sensor_senses(a: &[f64], b: &[f64], axis: &str) -> Option<Finding> {
+    let n = a.len().min(b.len());
+    if n < 3 {
+        return None;
+    }
+    let ma = a[..n].iter().sum::<f64>() / n as f64;
+    let mb = b[..n].iter().sum::<f64>() / n as f64;
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a[..n].iter().zip(&b[..n]) {
+        let (dx, dy) = (x - ma, y - mb);
+        sab += dx * dy;
+        saa += dx * dx;
+        sbb += dy * dy;
+    }
+    if saa <= 0.0 || sbb <= 0.0 {
+        return None;
+    }
+    let r = sab / (saa * sbb).sqrt();
+    (r < -0.2).then(|| Finding {
+        code: "sensor_senses_disagree",
+        subject: axis.into(),
+        message: format!(
+            "the two shank sensors' {axis} signals move in opposite senses (correlation {r:.2}): \
+             a bending shank moves both the same way"
+        ),
+        hint: format!(
+            "check the sign of sensor II's {axis} channel in the axis mapping (e.g. `-{axis}`) \
+             or the sensors' mounting"
+        ),
+        severity: Severity::NotIdentified,
+    })
+}
+
+/// The most serious severity among `findings` (None when empty).
+pub fn worst(findings: &[Finding]) -> Option<Severity> {
+    findings.iter().map(|f| f.severity).max()
+}
