@@ -55,7 +55,7 @@ pub struct FullSignalOptions {
     /// Start value of the runout vector e (mm); `None` = frequency-domain estimate.
     pub initial_runout: Option<[f64; 2]>,
     /// Fit through a measuring chain (fitted modes, a known FRF or a band limit) in the
-    /// harmonic domain ([`super::harmonic_fit`]); `None` = rigid sensor, time-domain fit.
+    /// harmonic domain (module `identify::harmonic_fit`); `None` = rigid sensor, time-domain fit.
     pub chain: Option<ChainOptions>,
     /// Hold the cutting coefficients [K_tc, K_rc, K_ac, K_te, K_re, K_ae] at these values (only
     /// with `chain`): a single recording cannot separate shear from edge coefficients, so the
@@ -114,7 +114,7 @@ pub struct FullSignalFit {
     pub offset_se_parts: SeParts,
 }
 
-/// Classic and robust standard errors of one quantity (see [`super::covariance`]).
+/// Classic and robust standard errors of one quantity (see module `identify::covariance`).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SeParts {
     /// s²·(JᵀJ)⁻¹, independent residuals of equal variance.
