@@ -97,14 +97,26 @@ fn identify_tests_csv_and_toml() {
     insta::assert_snapshot!(
         "identify_tests_csv",
         run(
-            &["identify", "tests", "examples/seed003_table1.csv", "--json", "-"],
+            &[
+                "identify",
+                "tests",
+                "examples/seed003_table1.csv",
+                "--json",
+                "-"
+            ],
             d.path()
         )
     );
     insta::assert_snapshot!(
         "identify_tests_toml",
         run(
-            &["identify", "tests", "examples/seed003_table1.toml", "--json", "-"],
+            &[
+                "identify",
+                "tests",
+                "examples/seed003_table1.toml",
+                "--json",
+                "-"
+            ],
             d.path()
         )
     );
@@ -148,7 +160,10 @@ fn chip_compare() {
     let d = tmp();
     for (name, case) in [
         ("chip_compare_section2_5", "examples/chip/section2_5.toml"),
-        ("chip_compare_joints_no_rtcp", "examples/chip/joints_no_rtcp.toml"),
+        (
+            "chip_compare_joints_no_rtcp",
+            "examples/chip/joints_no_rtcp.toml",
+        ),
     ] {
         let text = run(&["chip", "compare", case, "--json", "-"], d.path());
         assert!(text.contains("throughput_points_per_s"));
@@ -396,7 +411,15 @@ fn shank_force() {
     insta::assert_snapshot!(
         "shank_force_corrected",
         run(
-            &["shank", "force", s(&rec), "--config", s(&cfg), "--json", "-"],
+            &[
+                "shank",
+                "force",
+                s(&rec),
+                "--config",
+                s(&cfg),
+                "--json",
+                "-"
+            ],
             d.path()
         )
     );
