@@ -101,6 +101,18 @@ impl Source {
         }
     }
 
+    /// The source as a table input of `runout_io::displacement` (a file, or the bytes).
+    pub fn table_input(&self) -> runout_io::displacement::TableInput<'_> {
+        match &self.kind {
+            Kind::Path(p) => runout_io::displacement::TableInput::Path(p),
+            Kind::Bytes(b) => runout_io::displacement::TableInput::Reader {
+                name: &self.name,
+                reader: Box::new(&b[..]),
+                len: Some(b.len() as u64),
+            },
+        }
+    }
+
     /// A streaming recording reader over the source (header read; see
     /// [`RecordingReader::from_reader`]).
     pub fn open_recording(

@@ -20,6 +20,7 @@
 //! # Ok::<(), anyhow::Error>(())
 //! ```
 
+pub mod displacement;
 pub mod job;
 pub mod shank;
 pub mod spill;
