@@ -22,6 +22,7 @@
 
 pub mod displacement;
 pub mod job;
+pub mod schema;
 pub mod shank;
 pub mod spill;
 
