@@ -20,8 +20,9 @@ fn published_schemas_are_up_to_date() {
             std::fs::write(&p, &text).unwrap();
             continue;
         }
-        let published = std::fs::read_to_string(&p)
-            .unwrap_or_else(|e| panic!("{}: {e} (regenerate: RUNOUT_UPDATE_SCHEMAS=1)", p.display()));
+        let published = std::fs::read_to_string(&p).unwrap_or_else(|e| {
+            panic!("{}: {e} (regenerate: RUNOUT_UPDATE_SCHEMAS=1)", p.display())
+        });
         assert!(
             published == text,
             "{} is stale for {id}: regenerate with RUNOUT_UPDATE_SCHEMAS=1 cargo test -p runout --test schemas",
@@ -68,7 +69,10 @@ fn cli_outputs_validate_against_their_schemas() {
     }
     // every library report has at least one CLI output checked
     for id in schemas.keys() {
-        assert!(checked.contains_key(*id), "no CLI snapshot of {id}: {checked:?}");
+        assert!(
+            checked.contains_key(*id),
+            "no CLI snapshot of {id}: {checked:?}"
+        );
     }
 }
 
