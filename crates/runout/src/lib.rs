@@ -21,6 +21,7 @@
 //! ```
 
 pub mod displacement;
+pub mod grind;
 pub mod job;
 pub mod schema;
 pub mod shank;

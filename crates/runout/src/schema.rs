@@ -27,5 +27,7 @@ pub fn all() -> Vec<(&'static str, String, String)> {
         one::<crate::displacement::TeethReport>(),
         one::<crate::displacement::HeightsReport>(),
         one::<crate::displacement::SignalReport>(),
+        one::<crate::grind::CompensateReport>(),
+        one::<crate::grind::CheckReport>(),
     ]
 }
