@@ -27,6 +27,8 @@ pub fn all() -> Vec<(&'static str, String, String)> {
         one::<crate::displacement::TeethReport>(),
         one::<crate::displacement::HeightsReport>(),
         one::<crate::displacement::SignalReport>(),
+        one::<crate::chip::CompareReport>(),
+        one::<crate::chip::EvalReport>(),
         one::<crate::grind::CompensateReport>(),
         one::<crate::grind::CheckReport>(),
     ]

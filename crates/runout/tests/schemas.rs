@@ -40,6 +40,31 @@ fn snapshot_body(text: &str) -> &str {
     &rest[end + 5..]
 }
 
+/// The snapshot of `chip compare` has its wall-clock throughput redacted to a string: put a
+/// throughput of the documented shape back (the numbers are checked by the snapshot).
+fn unredact(v: &mut serde_json::Value, top: bool) {
+    match v {
+        serde_json::Value::Object(m) => {
+            for (k, x) in m.iter_mut() {
+                if k == "throughput_points_per_s" && x == "[throughput]" {
+                    let mut t = serde_json::Map::new();
+                    for model in ["exact", "equivalent", "arc"] {
+                        t.insert(model.into(), 1.0.into());
+                    }
+                    if top {
+                        t.insert("note".into(), "redacted".into());
+                    }
+                    *x = t.into();
+                } else {
+                    unredact(x, false);
+                }
+            }
+        }
+        serde_json::Value::Array(a) => a.iter_mut().for_each(|x| unredact(x, false)),
+        _ => {}
+    }
+}
+
 #[test]
 fn cli_outputs_validate_against_their_schemas() {
     let schemas: BTreeMap<&str, jsonschema::Validator> = runout::schema::all()
@@ -54,11 +79,12 @@ fn cli_outputs_validate_against_their_schemas() {
     for e in std::fs::read_dir(&dir).unwrap() {
         let p = e.unwrap().path();
         let text = std::fs::read_to_string(&p).unwrap();
-        let v: serde_json::Value = serde_json::from_str(snapshot_body(&text))
+        let mut v: serde_json::Value = serde_json::from_str(snapshot_body(&text))
             .unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+        unredact(&mut v, true);
         let id = v["schema"].as_str().unwrap_or_default().to_string();
         let Some(validator) = schemas.get(id.as_str()) else {
-            continue; // a job not yet in the library (identify, simulate, chip, grind)
+            continue; // a job not yet in the library (identify, simulate)
         };
         let errors: Vec<String> = validator
             .iter_errors(&v)
