@@ -32,6 +32,11 @@ sensor_II = "yII"
 
 /// A synthetic recording (20 kHz CSV, µm) of a 3-tooth cut with 10 µm runout, then its report.
 pub fn run() -> anyhow::Result<ForceReport> {
+    force(&request()?, &mut NoProgress)
+}
+
+/// The request: recording and config as bytes in memory.
+pub fn request() -> anyhow::Result<ForceRequest> {
     let cutter = Cutter::flat(8.0, 3, 30.0)?;
     let runout = Runout::new(0.010, 0.5)?;
     let cut = Cut::new(3000.0, 0.05, 2.0)?.radial(2.0, MillingMode::Down, &cutter)?;
@@ -67,11 +72,10 @@ pub fn run() -> anyhow::Result<ForceReport> {
         }
         csv.push('\n');
     }
-    let request = ForceRequest::new(
+    Ok(ForceRequest::new(
         Source::bytes("synthetic.csv", csv.into_bytes()),
         Source::bytes("shank.toml", CONFIG.as_bytes()),
-    );
-    force(&request, &mut NoProgress)
+    ))
 }
 
 fn main() -> anyhow::Result<()> {

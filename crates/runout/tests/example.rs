@@ -22,3 +22,46 @@ fn shank_force_example_recovers_the_runout() {
     let j: serde_json::Value = serde_json::from_str(&runout::to_json(&r).unwrap()).unwrap();
     assert_eq!(j["runout"]["tip_offset_um"], r.runout.tip_offset_um);
 }
+
+/// Progress: two stages (the two passes) over the whole input, each begun and ended once.
+#[test]
+fn shank_force_reports_progress_per_pass() {
+    #[derive(Default)]
+    struct Log(Vec<String>, u64, u64);
+    impl runout::Progress for Log {
+        fn begin(&mut self, stage: &str, total: Option<u64>) {
+            self.0.push(format!("begin {stage}"));
+            self.1 = total.unwrap_or(0);
+            self.2 = 0;
+        }
+        fn set_position(&mut self, bytes: u64) {
+            assert!(bytes >= self.2 && bytes <= self.1, "{bytes} of {}", self.1);
+            self.2 = bytes;
+        }
+        fn advance(&mut self, bytes: u64) {
+            self.2 += bytes;
+            assert!(self.2 <= self.1, "{} of {}", self.2, self.1);
+        }
+        fn end(&mut self) {
+            self.0.push(format!(
+                "end at {}",
+                if self.2 == self.1 { "total" } else { "less" }
+            ));
+        }
+    }
+    let req = example::request().unwrap();
+    let mut log = Log::default();
+    let a = runout::shank::force(&req, &mut log).unwrap();
+    assert_eq!(
+        log.0,
+        [
+            "begin pass 1/2",
+            "end at total",
+            "begin pass 2/2",
+            "end at total"
+        ]
+    );
+    // the progress sink does not change the result
+    let b = example::run().unwrap();
+    assert_eq!(runout::to_json(&a).unwrap(), runout::to_json(&b).unwrap());
+}
