@@ -135,9 +135,11 @@ mod tests {
     fn blocks_come_back_bit_for_bit_and_the_file_is_removed() {
         let path = Spill::temp_path("test");
         let mut s = Spill::create(path.clone(), 2).unwrap();
-        let mut c = Chunk::default();
-        c.time_s = vec![0.0, 0.1, 0.2];
-        c.values = vec![vec![1.0, f64::NAN, -0.0], vec![1e-300, 2.5, f64::INFINITY]];
+        let mut c = Chunk {
+            time_s: vec![0.0, 0.1, 0.2],
+            values: vec![vec![1.0, f64::NAN, -0.0], vec![1e-300, 2.5, f64::INFINITY]],
+            ..Default::default()
+        };
         s.write(&c).unwrap();
         c.time_s = vec![0.3];
         c.values = vec![vec![7.0], vec![8.0]];
