@@ -116,6 +116,9 @@ fn a_wrong_output_is_refused() {
     .unwrap();
     let mut good: serde_json::Value = serde_json::from_str(snapshot_body(&body)).unwrap();
     assert!(v.is_valid(&good));
+    let mut other_version = good.clone();
+    other_version["schema"] = "runout.shank.stiffness/2".into();
+    assert!(!v.is_valid(&other_version));
     good["stiffness_N_per_um"] = "1.9 N/um".into();
     assert!(!v.is_valid(&good));
     good.as_object_mut().unwrap().remove("stiffness_N_per_um");

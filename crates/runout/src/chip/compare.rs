@@ -139,6 +139,8 @@ pub struct EquivalentModel {
 /// `runout.chip.compare/1`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct CompareReport {
+    /// `runout.chip.compare/1`
+    #[schemars(extend("const" = "runout.chip.compare/1"))]
     pub schema: String,
     pub config: String,
     pub metrics: MetricsDefinitions,

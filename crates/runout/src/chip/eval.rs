@@ -44,6 +44,8 @@ pub struct EvalRequest {
 /// `runout.chip.eval/1`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct EvalReport {
+    /// `runout.chip.eval/1`
+    #[schemars(extend("const" = "runout.chip.eval/1"))]
     pub schema: String,
     pub case: String,
     pub model: String,

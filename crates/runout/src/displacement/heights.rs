@@ -43,6 +43,8 @@ pub struct VectorReport {
 /// `runout.displacement.heights/1`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct HeightsReport {
+    /// `runout.displacement.heights/1`
+    #[schemars(extend("const" = "runout.displacement.heights/1"))]
     pub schema: String,
     pub input: HeightsInput,
     pub method: String,

@@ -100,6 +100,8 @@ pub struct SignalTeeth {
 /// `runout.displacement.signal/1`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct SignalReport {
+    /// `runout.displacement.signal/1`
+    #[schemars(extend("const" = "runout.displacement.signal/1"))]
     pub schema: String,
     pub input: SignalInputReport,
     pub reference: String,

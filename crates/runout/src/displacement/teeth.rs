@@ -45,6 +45,8 @@ pub struct TeethInput {
 /// `runout.displacement.teeth/1`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct TeethReport {
+    /// `runout.displacement.teeth/1`
+    #[schemars(extend("const" = "runout.displacement.teeth/1"))]
     pub schema: String,
     pub input: TeethInput,
     pub method: String,

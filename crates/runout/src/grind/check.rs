@@ -68,6 +68,8 @@ pub struct SchemeCheck {
 /// `runout.grind.check/1`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct CheckReport {
+    /// `runout.grind.check/1`
+    #[schemars(extend("const" = "runout.grind.check/1"))]
     pub schema: String,
     pub inputs: CheckInputs,
     pub definitions: String,

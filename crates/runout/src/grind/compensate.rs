@@ -145,6 +145,8 @@ pub struct NcReport {
 /// `runout.grind.compensate/1`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct CompensateReport {
+    /// `runout.grind.compensate/1`
+    #[schemars(extend("const" = "runout.grind.compensate/1"))]
     pub schema: String,
     pub inputs: InputsReport,
     pub frame: String,

@@ -35,6 +35,8 @@ pub struct CalibrateRequest {
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 #[allow(non_snake_case)]
 pub struct CalibrationReport {
+    /// `runout.shank.calibration/1`
+    #[schemars(extend("const" = "runout.shank.calibration/1"))]
     pub schema: String,
     pub recording: String,
     pub steps: usize,

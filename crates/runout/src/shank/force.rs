@@ -190,6 +190,8 @@ pub struct OutputReport {
 /// `runout.shank.force/1`: force, deflections and runout from a shank recording.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct ForceReport {
+    /// `runout.shank.force/1`
+    #[schemars(extend("const" = "runout.shank.force/1"))]
     pub schema: String,
     pub recording: String,
     pub format: String,

@@ -55,6 +55,8 @@ pub struct BeamInputs {
 /// `runout.shank.stiffness/1`: K_δ of the beam model and its first bending mode.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct StiffnessReport {
+    /// `runout.shank.stiffness/1`
+    #[schemars(extend("const" = "runout.shank.stiffness/1"))]
     pub schema: String,
     pub first_bending_mode_hz: f64,
     pub density_kg_per_m3: f64,
