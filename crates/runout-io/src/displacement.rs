@@ -74,17 +74,53 @@ struct Table {
 }
 
 /// Open a CSV table: the header (lower-cased names) and the record reader positioned after it.
-fn open_table(path: &Path) -> Result<(Table, csv::Reader<std::fs::File>), TableError> {
-    let file = path.display().to_string();
+/// Where a table comes from: a file, or bytes from any reader with a name for messages and
+/// their size if known.
+pub enum TableInput<'a> {
+    /// A file.
+    Path(&'a Path),
+    /// A reader (bytes in memory, a network stream), named `name` in messages.
+    Reader {
+        /// Name used in messages, as a file's path would be.
+        name: &'a str,
+        /// The bytes.
+        reader: Box<dyn std::io::Read + 'a>,
+        /// Size in bytes, if known (checked against the table limit before reading).
+        len: Option<u64>,
+    },
+}
+
+impl<'a> From<&'a Path> for TableInput<'a> {
+    fn from(p: &'a Path) -> Self {
+        TableInput::Path(p)
+    }
+}
+
+impl<'a> From<&'a std::path::PathBuf> for TableInput<'a> {
+    fn from(p: &'a std::path::PathBuf) -> Self {
+        TableInput::Path(p)
+    }
+}
+
+type CsvReader<'a> = csv::Reader<Box<dyn std::io::Read + 'a>>;
+
+fn open_table(input: TableInput<'_>) -> Result<(Table, CsvReader<'_>), TableError> {
+    let (file, reader): (String, Box<dyn std::io::Read + '_>) = match input {
+        TableInput::Path(path) => {
+            let file = path.display().to_string();
+            let f = std::fs::File::open(path).map_err(|e| TableError::File {
+                file: file.clone(),
+                message: csv::Error::from(e).to_string(),
+            })?;
+            (file, Box::new(f))
+        }
+        TableInput::Reader { name, reader, .. } => (name.to_string(), reader),
+    };
     let mut rdr = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
         .trim(csv::Trim::All)
         .flexible(false)
-        .from_path(path)
-        .map_err(|e| TableError::File {
-            file: file.clone(),
-            message: e.to_string(),
-        })?;
+        .from_reader(reader);
     let headers: Vec<String> = rdr
         .headers()
         .map_err(|e| TableError::Header {
@@ -103,9 +139,9 @@ fn open_table(path: &Path) -> Result<(Table, csv::Reader<std::fs::File>), TableE
 }
 
 /// The next record and its 1-based line number, with a row error naming the line.
-fn next_record(
+fn next_record<R: std::io::Read>(
     t: &Table,
-    records: &mut csv::StringRecordsIter<'_, std::fs::File>,
+    records: &mut csv::StringRecordsIter<'_, R>,
 ) -> Result<Option<(u64, csv::StringRecord)>, TableError> {
     match records.next() {
         None => Ok(None),
@@ -119,20 +155,27 @@ fn next_record(
 }
 
 /// A whole (small) table in memory.
-fn read_table(path: &Path) -> Result<Table, TableError> {
+fn read_table(input: TableInput<'_>) -> Result<Table, TableError> {
     let max = runout_core::limits::MAX_TABLE_BYTES;
-    if let Ok(m) = std::fs::metadata(path) {
-        if m.is_file() && m.len() > max {
-            return Err(TableError::File {
-                file: path.display().to_string(),
-                message: format!(
-                    "{} bytes: larger than the {max} bytes a table may have (limit MAX_TABLE_BYTES)",
-                    m.len()
-                ),
-            });
-        }
+    let (name, len) = match &input {
+        TableInput::Path(path) => (
+            path.display().to_string(),
+            std::fs::metadata(path)
+                .ok()
+                .filter(|m| m.is_file())
+                .map(|m| m.len()),
+        ),
+        TableInput::Reader { name, len, .. } => (name.to_string(), *len),
+    };
+    if let Some(len) = len.filter(|&l| l > max) {
+        return Err(TableError::File {
+            file: name,
+            message: format!(
+                "{len} bytes: larger than the {max} bytes a table may have (limit MAX_TABLE_BYTES)"
+            ),
+        });
     }
-    let (mut t, mut rdr) = open_table(path)?;
+    let (mut t, mut rdr) = open_table(input)?;
     let mut records = rdr.records();
     while let Some(row) = next_record(&t, &mut records)? {
         t.rows.push(row);
@@ -238,8 +281,11 @@ pub struct ToothTable {
 
 /// Read a per-tooth readings table (`tooth,reading_um` or `seed_edge,reading_um`). `teeth` (K) is
 /// needed to map seed edges and to check tooth numbers.
-pub fn read_tooth_table(path: &Path, teeth: usize) -> Result<ToothTable, TableError> {
-    let t = read_table(path)?;
+pub fn read_tooth_table<'a>(
+    input: impl Into<TableInput<'a>>,
+    teeth: usize,
+) -> Result<ToothTable, TableError> {
+    let t = read_table(input.into())?;
     let reading = t
         .unit_column("reading", Quantity::LengthMm)?
         .ok_or_else(|| t.missing("`reading_<unit>` (e.g. reading_um)"))?;
@@ -304,8 +350,10 @@ pub struct HeightRow {
 }
 
 /// Read a multi-height table: `z_mm` and `tir_<unit>` or `runout_<unit>`, optional `angle_<unit>`.
-pub fn read_height_table(path: &Path) -> Result<Vec<HeightRow>, TableError> {
-    let t = read_table(path)?;
+pub fn read_height_table<'a>(
+    input: impl Into<TableInput<'a>>,
+) -> Result<Vec<HeightRow>, TableError> {
+    let t = read_table(input.into())?;
     let z = t
         .unit_column("z", Quantity::LengthMm)?
         .ok_or_else(|| t.missing("`z_<unit>` (e.g. z_mm)"))?;
@@ -409,8 +457,11 @@ impl Default for SignalSection {
 /// assert!((t.start_s - 0.011).abs() < 1e-12);
 /// assert!((t.sample_rate_hz - 1000.0).abs() < 1e-6);
 /// ```
-pub fn read_signal(path: &Path, section: &SignalSection) -> Result<SignalTable, TableError> {
-    let (t, mut rdr) = open_table(path)?;
+pub fn read_signal<'a>(
+    input: impl Into<TableInput<'a>>,
+    section: &SignalSection,
+) -> Result<SignalTable, TableError> {
+    let (t, mut rdr) = open_table(input.into())?;
     let time = t
         .unit_column("time", Quantity::TimeS)?
         .ok_or_else(|| t.missing("`time_<unit>` (e.g. time_s)"))?;

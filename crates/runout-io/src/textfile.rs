@@ -59,10 +59,28 @@ pub fn read_text(path: &Path) -> Result<String, TextFileError> {
     f.take(MAX_TABLE_BYTES + 1)
         .read_to_end(&mut bytes)
         .map_err(|e| err(None, format!("cannot read: {e}")))?;
+    text_from_bytes(&file, bytes)
+}
+
+/// The same checks as [`read_text`] on bytes already in memory (a config or table passed by a
+/// library caller); `file` names them in messages.
+pub fn text_from_bytes(file: &str, bytes: Vec<u8>) -> Result<String, TextFileError> {
+    let err = |line: Option<usize>, message: String| TextFileError {
+        file: file.to_string(),
+        line,
+        message,
+    };
     if bytes.len() as u64 > MAX_TABLE_BYTES {
-        return Err(too_big(bytes.len() as u64));
+        return Err(err(
+            None,
+            format!(
+                "{} bytes: larger than the {MAX_TABLE_BYTES} bytes a table, config or toolpath \
+                 may have (limit MAX_TABLE_BYTES); split the file",
+                bytes.len()
+            ),
+        ));
     }
-    check_lines(&file, &bytes)?;
+    check_lines(file, &bytes)?;
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let raw = e.as_bytes();

@@ -155,6 +155,12 @@ impl<'a> RecordingReader<std::io::Cursor<&'a [u8]>> {
 }
 
 impl<R: BufRead> RecordingReader<R> {
+    /// The same reader with its size in bytes set (for progress), when the source knows it.
+    pub fn with_file_bytes(mut self, bytes: Option<u64>) -> Self {
+        self.info.file_bytes = bytes;
+        self
+    }
+
     /// Read the header of a recording from `src`; `file` names it in messages.
     ///
     /// Recognises a DynoWare export by its first line (`DynoWare,Version …`), else a generic

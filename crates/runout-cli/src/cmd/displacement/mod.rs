@@ -1,18 +1,17 @@
 //! `runout displacement <teeth|heights|signal> …`: runout identified in position from displacement
-//! readings (methods.md §1, seed 000). Shared flags, parsing and output helpers live here; each
-//! input kind has its own file.
+//! readings (methods.md §1, seed 000). Flags → a request of [`runout::displacement`] → the
+//! report as JSON, text and plot. Shared flags and output helpers live here; each input kind
+//! has its own file.
 
 mod heights;
 mod signal;
 mod teeth;
 
 use anyhow::{bail, Context, Result};
-use runout_core::displacement::{
-    consequences, AngleEstimate, BeamGeometry, Consequences, SensorSign,
-};
-use runout_core::{Cutter, Runout};
+use runout::displacement::Sensor;
+use runout_core::displacement::{BeamGeometry, SensorSign};
+use runout_core::Cutter;
 use runout_io::units::{parse_quantity, Quantity};
-use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
 /// Input kinds of `runout displacement`.
@@ -57,14 +56,18 @@ pub struct OutputFlags {
 }
 
 impl OutputFlags {
-    /// Refuse outputs that overwrite `input`; then write JSON and text (text to stdout unless
-    /// the JSON goes there).
-    pub fn write(&self, input: &Path, json: &Value, text: &str) -> Result<()> {
+    /// Refuse outputs that overwrite `input`.
+    pub fn check(&self, input: &Path) -> Result<()> {
         for out in [&self.json, &self.text, &self.plot].into_iter().flatten() {
             crate::output::check_not_input(out, &[input])?;
         }
+        Ok(())
+    }
+
+    /// Write JSON and text (text to stdout unless the JSON goes there).
+    pub fn write<R: runout::Report>(&self, report: &R, text: &str) -> Result<()> {
         if let Some(j) = &self.json {
-            crate::output::write_text(j, &(serde_json::to_string_pretty(json)? + "\n"))?;
+            crate::output::write_text(j, &runout::to_json(report)?)?;
         }
         let json_on_stdout = self.json.as_deref() == Some(Path::new("-"));
         match &self.text {
@@ -149,11 +152,12 @@ impl CutterFlags {
     pub fn height(&self) -> Result<f64> {
         Ok(quantity("height-mm", &self.height_mm, Quantity::LengthMm)?.unwrap_or(0.0))
     }
-    /// Consequences (§1.7) of a determined runout.
-    pub fn consequences(&self, cutter: &Cutter, runout: &Runout) -> Result<Consequences> {
-        let fz = quantity("fz-mm", &self.fz_mm, Quantity::LengthMm)?;
-        let hole = quantity("hole-path-mm", &self.hole_path_mm, Quantity::LengthMm)?;
-        Ok(consequences(cutter, runout, self.height()?, fz, hole)?)
+    /// Feed per tooth (mm) and hole path diameter (mm) for the consequences (§1.7).
+    pub fn fz_and_hole(&self) -> Result<(Option<f64>, Option<f64>)> {
+        Ok((
+            quantity("fz-mm", &self.fz_mm, Quantity::LengthMm)?,
+            quantity("hole-path-mm", &self.hole_path_mm, Quantity::LengthMm)?,
+        ))
     }
 }
 
@@ -180,99 +184,11 @@ impl BeamFlags {
             quantity("beam-offset-mm", &self.beam_offset_mm, Quantity::LengthMm)?.unwrap_or(0.0);
         Ok(BeamGeometry::new(inc.to_radians(), b)?)
     }
-    /// JSON echo.
-    pub fn json(&self) -> Result<Value> {
-        let b = self.beam()?;
-        Ok(json!({
-            "sensor": format!("{:?}", sensor_sign(&self.sensor)?).to_lowercase(),
-            "inclination_deg": b.inclination().to_degrees(),
-            "beam_offset_mm": b.offset(),
-        }))
-    }
-}
-
-/// JSON fields of an angle estimate (degrees).
-pub fn angle_json(a: &AngleEstimate) -> Value {
-    let se = a.se().map(f64::to_degrees);
-    match a {
-        AngleEstimate::Determined { angle_rad, .. } => json!({
-            "angle_status": "determined", "angle_deg": angle_rad.to_degrees(), "angle_se_deg": se,
-        }),
-        AngleEstimate::Ambiguous {
-            candidates_rad,
-            reason,
-            ..
-        } => json!({
-            "angle_status": "ambiguous", "angle_deg": null, "angle_se_deg": se,
-            "angle_candidates_deg": [candidates_rad[0].to_degrees(), candidates_rad[1].to_degrees()],
-            "angle_reason": reason,
-        }),
-        AngleEstimate::Undetermined {
-            reason,
-            rejected_rad,
-            ..
-        } => json!({
-            "angle_status": "undetermined", "angle_deg": null, "angle_se_deg": se,
-            "angle_rejected_deg": rejected_rad.map(f64::to_degrees), "angle_reason": reason,
-        }),
-    }
-}
-
-/// Text line of an angle estimate.
-pub fn angle_text(a: &AngleEstimate) -> String {
-    let se = |s: Option<f64>| {
-        s.map_or("σ unknown".to_string(), |s| {
-            format!("± {:.2}° (1σ)", s.to_degrees())
+    /// The sensor: sign convention and beam.
+    pub fn sensor(&self) -> Result<Sensor> {
+        Ok(Sensor {
+            sign: sensor_sign(&self.sensor)?,
+            beam: self.beam()?,
         })
-    };
-    match a {
-        AngleEstimate::Determined { angle_rad, se_rad } => {
-            format!("angle λ = {:.2}° {}", angle_rad.to_degrees(), se(*se_rad))
-        }
-        AngleEstimate::Ambiguous {
-            candidates_rad,
-            se_rad,
-            reason,
-        } => format!(
-            "angle λ = {:.2}° or {:.2}° {} — AMBIGUOUS: {reason}",
-            candidates_rad[0].to_degrees(),
-            candidates_rad[1].to_degrees(),
-            se(*se_rad)
-        ),
-        AngleEstimate::Undetermined { reason, .. } => format!("angle λ UNDETERMINED: {reason}"),
     }
-}
-
-/// JSON of the consequences (§1.7).
-pub fn consequences_json(c: &Consequences) -> Value {
-    json!({
-        "height_mm": c.height_mm,
-        "tooth_radii_mm": c.tooth_radii_mm,
-        "slot_width_mm": c.slot_width_mm,
-        "hole_diameter_mm": c.hole_diameter_mm,
-        "fz_mm": c.fz_mm,
-        "chip_load_um": c.chip_load_mm.as_ref().map(|v| v.iter().map(|h| h * 1e3).collect::<Vec<_>>()),
-    })
-}
-
-/// Text of the consequences.
-pub fn consequences_text(c: &Consequences) -> String {
-    let mut s = String::from("predicted (methods.md §1.7):\n");
-    for (i, r) in c.tooth_radii_mm.iter().enumerate() {
-        s += &format!("  tooth {i}: radius {r:.6} mm");
-        if let Some(h) = &c.chip_load_mm {
-            s += &format!(", chip load {:.3} µm", h[i] * 1e3);
-        }
-        s += "\n";
-    }
-    s += &format!("  slot width {:.6} mm\n", c.slot_width_mm);
-    if let Some(d) = c.hole_diameter_mm {
-        s += &format!("  hole diameter {d:.6} mm\n");
-    }
-    s
-}
-
-/// Notes as text lines.
-pub fn notes_text(notes: &[String]) -> String {
-    notes.iter().map(|n| format!("note: {n}\n")).collect()
 }

@@ -1,12 +1,13 @@
 //! `runout grind …`: grinding compensation of the bar clamping error (seed 004, methods.md §5).
+//! Flags → a request of [`runout::grind`] → the report as JSON, text, plots and files.
 
 mod check;
 mod compensate;
 
-use anyhow::{bail, Context, Result};
-use runout_core::grind::EdgeLine;
+use anyhow::{Context, Result};
+use runout::grind::{EdgeSpec, GeneratedEdge};
+use runout::Source;
 use runout_io::units::{parse_quantity, Quantity};
-use std::path::{Path, PathBuf};
 
 /// `runout grind …`
 #[derive(clap::Args, Debug)]
@@ -66,54 +67,39 @@ pub(crate) fn q(flag: &str, text: &str, quantity: Quantity) -> Result<f64> {
     parse_quantity(text, quantity).with_context(|| format!("--{flag}"))
 }
 
-pub(crate) fn read(path: &Path, what: &str) -> Result<String> {
-    runout_io::textfile::read_text(path).with_context(|| format!("reading {what}"))
-}
-
-/// The edge and, for CSV edges, the wheel positions and the CSV path.
-pub(crate) type EdgeInput = (EdgeLine, Option<Vec<[f64; 3]>>, Option<PathBuf>);
-
-/// Build the edge; `bar_d` and `u_end` are the defaults for the diameter and the edge end (mm).
-pub(crate) fn edge(a: &EdgeFlags, bar_d: f64, u_end: f64) -> Result<EdgeInput> {
-    let kind = a.kind.as_str();
-    if kind != "flat" && kind != "ball" {
-        let p = PathBuf::from(kind);
-        let text = read(&p, "edge")?;
-        let t = runout_io::grind::read_edge_csv(&text, kind)?;
-        for (k, p) in t.points.iter().enumerate() {
-            let on_axis = p[0].hypot(p[1]) == 0.0;
-            let zero_normal = t.normals.as_ref().is_some_and(|n| n[k] == [0.0; 3]);
-            if zero_normal || (on_axis && t.normals.is_none()) {
-                bail!(
-                    "{kind}, line {}: {} (its offset direction is undefined)",
-                    t.lines[k],
-                    if zero_normal {
-                        "normal (0, 0, 0)"
-                    } else {
-                        "point on the bar axis without a normal"
-                    }
-                );
-            }
-        }
-        let e = EdgeLine::from_points(&t.points, t.normals.as_deref())
-            .with_context(|| format!("edge {kind}"))?;
-        return Ok((e, t.wheel, Some(p)));
+impl EdgeFlags {
+    /// True for a generated edge (`flat` or `ball`), false for a CSV file.
+    pub fn generated(&self) -> bool {
+        self.kind == "flat" || self.kind == "ball"
     }
-    let d = match &a.edge_diameter_mm {
-        Some(d) => q("edge-diameter-mm", d, Quantity::LengthMm)?,
-        None => bar_d,
-    };
-    let helix = q("helix-deg", &a.helix_deg, Quantity::AngleDeg)?;
-    let z0 = q("edge-from-mm", &a.edge_from_mm, Quantity::LengthMm)?;
-    let z1 = match &a.edge_to_mm {
-        Some(z) => q("edge-to-mm", z, Quantity::LengthMm)?,
-        None => u_end,
-    };
-    let phase = q("edge-phase-deg", &a.edge_phase_deg, Quantity::AngleDeg)?.to_radians();
-    let e = if kind == "flat" {
-        EdgeLine::helical_flat(d, a.flutes, helix, z0, z1, a.points_per_flute)?
-    } else {
-        EdgeLine::ball_end(d, a.flutes, helix, z0, z1, a.points_per_flute)?
-    };
-    Ok((e.rotated(phase), None, None))
+
+    /// The edge: a CSV source, or the generated edge's parameters.
+    pub fn spec(&self) -> Result<EdgeSpec> {
+        if !self.generated() {
+            return Ok(EdgeSpec::Csv(Source::path(&self.kind)));
+        }
+        Ok(EdgeSpec::Generated(self.generated_edge()?))
+    }
+
+    /// The generated edge's parameters from the flags.
+    pub fn generated_edge(&self) -> Result<GeneratedEdge> {
+        Ok(GeneratedEdge {
+            ball: self.kind == "ball",
+            diameter_mm: self
+                .edge_diameter_mm
+                .as_deref()
+                .map(|d| q("edge-diameter-mm", d, Quantity::LengthMm))
+                .transpose()?,
+            flutes: self.flutes,
+            helix_deg: q("helix-deg", &self.helix_deg, Quantity::AngleDeg)?,
+            from_mm: q("edge-from-mm", &self.edge_from_mm, Quantity::LengthMm)?,
+            to_mm: self
+                .edge_to_mm
+                .as_deref()
+                .map(|z| q("edge-to-mm", z, Quantity::LengthMm))
+                .transpose()?,
+            points_per_flute: self.points_per_flute,
+            phase_rad: q("edge-phase-deg", &self.edge_phase_deg, Quantity::AngleDeg)?.to_radians(),
+        })
+    }
 }

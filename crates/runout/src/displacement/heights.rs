@@ -1,0 +1,126 @@
+//! `displacement heights`: runout at several heights → runout at the cutting height
+//! (methods.md §1.3; §1.6 vector fit when the table has an angle column).
+
+use super::{name_of, AngleReport};
+use crate::job::{Report, Source};
+use anyhow::{Context, Result};
+use runout_core::displacement::{
+    runout_at_height, vector_at_height, HeightFit, HeightRegression, VectorHeightFit,
+};
+use runout_io::displacement::read_height_table;
+use schemars::JsonSchema;
+use serde::Serialize;
+
+/// `runout displacement heights`.
+#[derive(Debug, Clone)]
+pub struct HeightsRequest {
+    /// CSV with `z_<mm>` and `tir_<um>` or `runout_<um>`, optional `angle_<deg>`.
+    pub table: Source,
+    /// Height at which the runout is wanted (mm).
+    pub at_mm: f64,
+    pub method: HeightRegression,
+}
+
+/// The input as reported.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct HeightsInput {
+    pub file: String,
+    pub points: usize,
+}
+
+/// The offset + tilt vector fit (§1.6).
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct VectorReport {
+    pub offset_um: f64,
+    pub offset_se_um: Option<f64>,
+    pub offset_at_zero_um: [f64; 2],
+    pub tilt_um_per_mm: [f64; 2],
+    pub residual_rms_um: f64,
+    #[serde(flatten)]
+    pub angle: AngleReport,
+}
+
+/// `runout.displacement.heights/1`.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct HeightsReport {
+    /// `runout.displacement.heights/1`
+    #[schemars(extend("const" = "runout.displacement.heights/1"))]
+    pub schema: String,
+    pub input: HeightsInput,
+    pub method: String,
+    pub at_mm: f64,
+    pub offset_um: f64,
+    pub offset_se_um: Option<f64>,
+    pub slope_um_per_mm: f64,
+    pub slope_se_um_per_mm: Option<f64>,
+    pub r_squared: f64,
+    pub residual_rms_um: f64,
+    pub notes: Vec<String>,
+    pub vector: Option<VectorReport>,
+    /// The core results behind the text and the plot; not part of the JSON.
+    #[serde(skip)]
+    #[schemars(skip)]
+    pub detail: HeightsDetail,
+}
+
+/// The core results of `displacement heights`.
+#[derive(Debug, Clone, Default)]
+pub struct HeightsDetail {
+    /// (z mm, runout mm) points.
+    pub points: Vec<(f64, f64)>,
+    pub fit: Option<HeightFit>,
+    pub vector: Option<VectorHeightFit>,
+}
+
+impl Report for HeightsReport {
+    const SCHEMA: &'static str = "runout.displacement.heights/1";
+}
+
+/// Regress runout on height; with angles, the offset + tilt vector fit as well.
+pub fn heights(req: &HeightsRequest) -> Result<HeightsReport> {
+    let rows = read_height_table(req.table.table_input())?;
+    let file = req.table.name().to_string();
+    let at = req.at_mm;
+    let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.z_mm, r.runout_mm)).collect();
+    let fit = runout_at_height(&pts, at, req.method).with_context(|| file.clone())?;
+    let vpts: Option<Vec<(f64, [f64; 2])>> = rows
+        .iter()
+        .map(|r| {
+            r.angle_rad
+                .map(|l| (r.z_mm, [r.runout_mm * l.cos(), r.runout_mm * l.sin()]))
+        })
+        .collect();
+    let vector = vpts
+        .map(|p| vector_at_height(&p, at))
+        .transpose()
+        .with_context(|| file.clone())?;
+    Ok(HeightsReport {
+        schema: HeightsReport::SCHEMA.into(),
+        input: HeightsInput {
+            file,
+            points: fit.points,
+        },
+        method: name_of(&fit.method),
+        at_mm: fit.height_mm,
+        offset_um: fit.offset_mm * 1e3,
+        offset_se_um: fit.offset_se_mm.map(|s| s * 1e3),
+        slope_um_per_mm: fit.slope * 1e3,
+        slope_se_um_per_mm: fit.slope_se.map(|s| s * 1e3),
+        r_squared: fit.r_squared,
+        residual_rms_um: fit.residual_rms_mm * 1e3,
+        notes: fit.notes.clone(),
+        vector: vector.as_ref().map(|v| VectorReport {
+            offset_um: v.offset_mm * 1e3,
+            offset_se_um: v.offset_se_mm.map(|s| s * 1e3),
+            offset_at_zero_um: [v.offset_at_zero_mm[0] * 1e3, v.offset_at_zero_mm[1] * 1e3],
+            tilt_um_per_mm: [v.tilt[0] * 1e3, v.tilt[1] * 1e3],
+            residual_rms_um: v.residual_rms_mm * 1e3,
+            angle: AngleReport::from(&v.angle),
+        }),
+        detail: HeightsDetail {
+            points: pts,
+            fit: Some(fit),
+            vector,
+        },
+    })
+}

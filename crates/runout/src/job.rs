@@ -1,0 +1,195 @@
+//! The job framework: where inputs come from ([`Source`]), how progress is reported
+//! ([`Progress`]), and the report convention ([`Report`]).
+
+use runout_io::recording::{ReadOptions, RecordingError, RecordingReader};
+use runout_io::textfile::TextFileError;
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Progress of a long job, in bytes of input per stage (a pass over a recording). The CLI
+/// turns it into progress bars; a library caller may ignore it ([`NoProgress`]).
+pub trait Progress {
+    /// A stage starts (`"pass 1/2"`), over `total_bytes` of input if known.
+    fn begin(&mut self, _stage: &str, _total_bytes: Option<u64>) {}
+    /// Bytes of the stage done so far.
+    fn set_position(&mut self, _bytes: u64) {}
+    /// Bytes done since the last call.
+    fn advance(&mut self, _bytes: u64) {}
+    /// The stage is finished.
+    fn end(&mut self) {}
+}
+
+/// Reports nothing.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct NoProgress;
+
+impl Progress for NoProgress {}
+
+/// A typed report: serialises to the job's JSON; `SCHEMA` is its `schema` field
+/// (`runout.<job>/<version>`; the version changes when a field changes meaning or is removed).
+pub trait Report: serde::Serialize + schemars::JsonSchema {
+    /// `runout.<job>/<version>`.
+    const SCHEMA: &'static str;
+}
+
+/// The report as pretty JSON with a final newline (what `--json` writes).
+pub fn to_json<R: Report>(report: &R) -> serde_json::Result<String> {
+    Ok(serde_json::to_string_pretty(report)? + "\n")
+}
+
+/// Where an input comes from: a file, or bytes in memory (from Python, a network, a distributed
+/// engine) with a display name. Messages name the source by [`Source::name`] as they name a
+/// file, with line and column.
+#[derive(Debug, Clone)]
+pub struct Source {
+    name: String,
+    kind: Kind,
+}
+
+#[derive(Debug, Clone)]
+enum Kind {
+    Path(PathBuf),
+    Bytes(Arc<[u8]>),
+}
+
+impl Source {
+    /// A file.
+    pub fn path(path: impl Into<PathBuf>) -> Self {
+        let path = path.into();
+        Self {
+            name: path.display().to_string(),
+            kind: Kind::Path(path),
+        }
+    }
+
+    /// Bytes in memory, named `name` in messages.
+    pub fn bytes(name: impl Into<String>, bytes: impl Into<Arc<[u8]>>) -> Self {
+        Self {
+            name: name.into(),
+            kind: Kind::Bytes(bytes.into()),
+        }
+    }
+
+    /// The name used in messages and reports (the path as given, for a file).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The file, if the source is one.
+    pub fn as_path(&self) -> Option<&Path> {
+        match &self.kind {
+            Kind::Path(p) => Some(p),
+            Kind::Bytes(_) => None,
+        }
+    }
+
+    /// The folder that relative file names inside this source are resolved from (the file's
+    /// folder; `.` for bytes).
+    pub fn dir(&self) -> &Path {
+        self.as_path()
+            .and_then(Path::parent)
+            .unwrap_or(Path::new("."))
+    }
+
+    /// The whole source as UTF-8 text, with the size and line-length limits of
+    /// [`runout_io::textfile::read_text`].
+    pub fn read_text(&self) -> Result<String, TextFileError> {
+        match &self.kind {
+            Kind::Path(p) => runout_io::textfile::read_text(p),
+            Kind::Bytes(b) => runout_io::textfile::text_from_bytes(&self.name, b.to_vec()),
+        }
+    }
+
+    /// The source as a table input of `runout_io::displacement` (a file, or the bytes).
+    pub fn table_input(&self) -> runout_io::displacement::TableInput<'_> {
+        match &self.kind {
+            Kind::Path(p) => runout_io::displacement::TableInput::Path(p),
+            Kind::Bytes(b) => runout_io::displacement::TableInput::Reader {
+                name: &self.name,
+                reader: Box::new(&b[..]),
+                len: Some(b.len() as u64),
+            },
+        }
+    }
+
+    /// A streaming recording reader over the source (header read; see
+    /// [`RecordingReader::from_reader`]).
+    pub fn open_recording(
+        &self,
+        options: &ReadOptions,
+    ) -> Result<RecordingReader<Box<dyn BufRead + Send>>, RecordingError> {
+        match &self.kind {
+            Kind::Path(p) => {
+                let f = std::fs::File::open(p).map_err(|source| RecordingError::Io {
+                    file: self.name.clone(),
+                    source,
+                })?;
+                let size = f.metadata().ok().map(|m| m.len());
+                let src: Box<dyn BufRead + Send> =
+                    Box::new(std::io::BufReader::with_capacity(1 << 16, f));
+                Ok(RecordingReader::from_reader(src, &self.name, options)?.with_file_bytes(size))
+            }
+            Kind::Bytes(b) => {
+                let src: Box<dyn BufRead + Send> = Box::new(std::io::Cursor::new(b.clone()));
+                Ok(RecordingReader::from_reader(src, &self.name, options)?
+                    .with_file_bytes(Some(b.len() as u64)))
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_source_in_memory_reads_like_a_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("r.csv");
+        let text = "time_s,a_um\n0,1\n0.001,2\n0.002,3\n";
+        std::fs::write(&p, text).unwrap();
+        let o = ReadOptions::new();
+        let from_file = Source::path(&p).open_recording(&o).unwrap();
+        let from_bytes = Source::bytes("mem.csv", text.as_bytes())
+            .open_recording(&o)
+            .unwrap();
+        assert_eq!(
+            from_file.info().sample_rate_hz,
+            from_bytes.info().sample_rate_hz
+        );
+        assert_eq!(from_bytes.info().file, "mem.csv");
+        assert_eq!(from_bytes.info().file_bytes, Some(text.len() as u64));
+        assert_eq!(from_file.info().file_bytes, Some(text.len() as u64));
+        // messages name the in-memory source like a file, with its line
+        let bad = Source::bytes("mem.csv", &b"time_s,a_um\n0,1\n0.001,x\n"[..]);
+        let mut r = bad.open_recording(&o).unwrap();
+        let mut chunk = runout_io::recording::Chunk::default();
+        let e = loop {
+            match r.read_chunk(&mut chunk, 10) {
+                Ok(0) => panic!("bad value accepted"),
+                Ok(_) => {}
+                Err(e) => break e.to_string(),
+            }
+        };
+        assert!(e.starts_with("mem.csv:3"), "{e}");
+        // text sources keep the limits and name the source
+        let e = Source::bytes("cfg.toml", &[0xffu8, 0xfe][..])
+            .read_text()
+            .unwrap_err();
+        assert!(e.to_string().starts_with("cfg.toml:1: not UTF-8"), "{e}");
+        assert_eq!(Source::path(&p).read_text().unwrap(), text);
+        assert_eq!(Source::path(&p).dir(), dir.path());
+        assert_eq!(Source::bytes("x", &b""[..]).dir(), Path::new("."));
+    }
+
+    #[test]
+    fn a_missing_file_is_named() {
+        let e = Source::path("/no/such/rec.csv")
+            .open_recording(&ReadOptions::new())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("/no/such/rec.csv"), "{e}");
+    }
+}

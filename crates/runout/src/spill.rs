@@ -1,0 +1,161 @@
+//! The two-pass helper: jobs that read a long recording twice (a survey, then the output) keep
+//! the converted channels of pass 1 in a temporary binary file and read them back in pass 2
+//! instead of parsing the text again.
+//!
+//! Layout, per block: u64 LE row count, then each channel's values as f64 LE. The file is
+//! deleted when the [`Spill`] is dropped (also on errors).
+
+use runout_io::recording::Chunk;
+use std::fs::File;
+use std::io::{self, BufReader, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+
+/// A temporary binary copy of a recording's channels, written block by block.
+#[derive(Debug)]
+pub struct Spill {
+    path: PathBuf,
+    writer: Option<BufWriter<File>>,
+    channels: usize,
+    rows: u64,
+}
+
+impl Spill {
+    /// A fresh name in the temporary directory: `runout-<tag>-<pid>-<nanos>.tmp`.
+    pub fn temp_path(tag: &str) -> PathBuf {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        std::env::temp_dir().join(format!("runout-{tag}-{}-{nanos}.tmp", std::process::id()))
+    }
+
+    /// Create the file at `path` for blocks of `channels` columns.
+    pub fn create(path: PathBuf, channels: usize) -> io::Result<Self> {
+        let f = File::create(&path)?;
+        Ok(Self {
+            path,
+            writer: Some(BufWriter::with_capacity(1 << 20, f)),
+            channels,
+            rows: 0,
+        })
+    }
+
+    /// The file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Rows written so far.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// Append the chunk's channels (its time column is not kept: pass 2 numbers samples from
+    /// 0). Panics if called after [`Spill::reader`].
+    pub fn write(&mut self, chunk: &Chunk) -> io::Result<()> {
+        let w = self
+            .writer
+            .as_mut()
+            .expect("spill written before it is read");
+        let n = chunk.len();
+        let mut bytes = Vec::with_capacity(8 + 8 * n * self.channels);
+        bytes.extend_from_slice(&(n as u64).to_le_bytes());
+        for c in chunk.values.iter().take(self.channels) {
+            for v in c {
+                bytes.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        self.rows += n as u64;
+        w.write_all(&bytes)
+    }
+
+    /// Finish writing and read the blocks back from the start.
+    pub fn reader(&mut self) -> io::Result<SpillReader> {
+        if let Some(mut w) = self.writer.take() {
+            w.flush()?;
+        }
+        let f = File::open(&self.path)?;
+        Ok(SpillReader {
+            r: BufReader::with_capacity(1 << 20, f),
+            channels: self.channels,
+            first: 0,
+            bytes: Vec::new(),
+        })
+    }
+}
+
+impl Drop for Spill {
+    fn drop(&mut self) {
+        self.writer = None;
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// Reads a [`Spill`] back block by block.
+#[derive(Debug)]
+pub struct SpillReader {
+    r: BufReader<File>,
+    channels: usize,
+    first: u64,
+    bytes: Vec<u8>,
+}
+
+impl SpillReader {
+    /// The next block into `chunk` (values only, `first_sample` set, no time column); 0 at the end.
+    pub fn read_chunk(&mut self, chunk: &mut Chunk) -> io::Result<usize> {
+        let mut head = [0u8; 8];
+        match self.r.read_exact(&mut head) {
+            Ok(()) => {}
+            Err(e) if e.kind() == io::ErrorKind::UnexpectedEof => return Ok(0),
+            Err(e) => return Err(e),
+        }
+        let n = u64::from_le_bytes(head) as usize;
+        chunk.first_sample = self.first;
+        chunk.time_s.clear();
+        chunk.values.resize_with(self.channels, Vec::new);
+        self.bytes.resize(8 * n, 0);
+        for c in &mut chunk.values {
+            self.r.read_exact(&mut self.bytes)?;
+            c.clear();
+            c.extend(
+                self.bytes
+                    .chunks_exact(8)
+                    .map(|b| f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]])),
+            );
+        }
+        self.first += n as u64;
+        Ok(n)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blocks_come_back_bit_for_bit_and_the_file_is_removed() {
+        let path = Spill::temp_path("test");
+        let mut s = Spill::create(path.clone(), 2).unwrap();
+        let mut c = Chunk {
+            time_s: vec![0.0, 0.1, 0.2],
+            values: vec![vec![1.0, f64::NAN, -0.0], vec![1e-300, 2.5, f64::INFINITY]],
+            ..Default::default()
+        };
+        s.write(&c).unwrap();
+        c.time_s = vec![0.3];
+        c.values = vec![vec![7.0], vec![8.0]];
+        s.write(&c).unwrap();
+        assert_eq!(s.rows(), 4);
+        let mut r = s.reader().unwrap();
+        let mut back = Chunk::default();
+        assert_eq!(r.read_chunk(&mut back).unwrap(), 3);
+        assert_eq!(back.first_sample, 0);
+        assert!(back.values[0][1].is_nan() && back.values[0][2].is_sign_negative());
+        assert_eq!(back.values[1], vec![1e-300, 2.5, f64::INFINITY]);
+        assert_eq!(r.read_chunk(&mut back).unwrap(), 1);
+        assert_eq!((back.first_sample, back.values[1][0]), (3, 8.0));
+        assert_eq!(r.read_chunk(&mut back).unwrap(), 0);
+        assert!(path.exists());
+        drop(s);
+        assert!(!path.exists());
+    }
+}
