@@ -76,20 +76,31 @@ struct Table {
 /// Open a CSV table: the header (lower-cased names) and the record reader positioned after it.
 fn open_table(path: &Path) -> Result<(Table, csv::Reader<std::fs::File>), TableError> {
     let file = path.display().to_string();
+    let unreadable = |e: &std::io::Error| TableError::File {
+        file: file.clone(),
+        message: format!("cannot read: {}", crate::report::io_problem(e)),
+    };
+    let f = std::fs::File::open(path).map_err(|e| unreadable(&e))?;
+    if f.metadata().map_err(|e| unreadable(&e))?.is_dir() {
+        return Err(TableError::File {
+            file,
+            message: "is a folder: expected a CSV file".into(),
+        });
+    }
     let mut rdr = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
         .trim(csv::Trim::All)
         .flexible(false)
-        .from_path(path)
-        .map_err(|e| TableError::File {
-            file: file.clone(),
-            message: e.to_string(),
-        })?;
+        .from_reader(f);
     let headers: Vec<String> = rdr
         .headers()
-        .map_err(|e| TableError::Header {
-            file: file.clone(),
-            message: e.to_string(),
+        .map_err(|e| match e.kind() {
+            csv::ErrorKind::Io(e) => unreadable(e),
+            _ => TableError::Row {
+                file: file.clone(),
+                line: e.position().map_or(1, |p| p.line()),
+                message: format!("header: {}", csv_problem(&e)),
+            },
         })?
         .iter()
         .map(|h| h.trim().to_ascii_lowercase())
@@ -109,12 +120,34 @@ fn next_record(
 ) -> Result<Option<(u64, csv::StringRecord)>, TableError> {
     match records.next() {
         None => Ok(None),
-        Some(Err(e)) => Err(TableError::Row {
-            file: t.file.clone(),
-            line: e.position().map_or(0, |p| p.line()),
-            message: e.to_string(),
+        Some(Err(e)) => Err(match e.position() {
+            Some(p) => TableError::Row {
+                file: t.file.clone(),
+                line: p.line(),
+                message: csv_problem(&e),
+            },
+            None => TableError::File {
+                file: t.file.clone(),
+                message: csv_problem(&e),
+            },
         }),
         Some(Ok(rec)) => Ok(Some((rec.position().map_or(0, |p| p.line()), rec))),
+    }
+}
+
+/// A CSV reader's error without its position (the caller names the line), with what to do.
+fn csv_problem(e: &csv::Error) -> String {
+    match e.kind() {
+        csv::ErrorKind::Io(e) => format!("cannot read: {}", crate::report::io_problem(e)),
+        csv::ErrorKind::Utf8 { .. } => {
+            "not UTF-8 text (a binary file, or another encoding: save it as UTF-8)".into()
+        }
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!(
+            "{len} fields, expected {expected_len} as in the header (a missing or extra separator)"
+        ),
+        _ => e.to_string(),
     }
 }
 

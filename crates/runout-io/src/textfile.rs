@@ -45,12 +45,12 @@ pub fn read_text(path: &Path) -> Result<String, TextFileError> {
             ),
         )
     };
-    let f = std::fs::File::open(path).map_err(|e| err(None, format!("cannot read: {e}")))?;
+    let f = std::fs::File::open(path).map_err(|e| err(None, format!("cannot read: {}", crate::report::io_problem(&e))))?;
     let meta = f
         .metadata()
-        .map_err(|e| err(None, format!("cannot read: {e}")))?;
+        .map_err(|e| err(None, format!("cannot read: {}", crate::report::io_problem(&e))))?;
     if meta.is_dir() {
-        return Err(err(None, "is a folder, expected a file".into()));
+        return Err(err(None, "is a folder: expected a file".into()));
     }
     if meta.len() > MAX_TABLE_BYTES {
         return Err(too_big(meta.len()));
@@ -58,7 +58,7 @@ pub fn read_text(path: &Path) -> Result<String, TextFileError> {
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     f.take(MAX_TABLE_BYTES + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| err(None, format!("cannot read: {e}")))?;
+        .map_err(|e| err(None, format!("cannot read: {}", crate::report::io_problem(&e))))?;
     if bytes.len() as u64 > MAX_TABLE_BYTES {
         return Err(too_big(bytes.len() as u64));
     }
