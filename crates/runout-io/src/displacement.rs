@@ -193,7 +193,9 @@ impl Table {
             let factor = q.unit_factor(unit).ok_or_else(|| TableError::Header {
                 file: self.file.clone(),
                 message: format!(
-                    "column `{h}`: unit `{unit}` is not a unit of {q} (e.g. `{base}_{}`)",
+                    "column `{}`: unit `{}` is not a unit of {q} (e.g. `{base}_{}`)",
+                    crate::textfile::quote(h),
+                    crate::textfile::quote(unit),
                     q.unit().replace('µ', "u")
                 ),
             })?;
@@ -222,7 +224,7 @@ impl Table {
             file: self.file.clone(),
             message: format!(
                 "no column {what}; the header has {}",
-                self.headers.join(", ")
+                crate::textfile::quote(&self.headers.join(", "))
             ),
         }
     }
@@ -459,7 +461,11 @@ pub fn read_signal(path: &Path, section: &SignalSection) -> Result<SignalTable, 
         .map(|(index, h, name, unit)| {
             let factor = Quantity::LengthMm.unit_factor(&unit).ok_or_else(|| TableError::Header {
                 file: t.file.clone(),
-                message: format!("column `{h}`: expected `disp_<name>_<unit>` with a length unit (um, mm), got unit `{unit}`"),
+                message: format!(
+                    "column `{}`: expected `disp_<name>_<unit>` with a length unit (um, mm), got unit `{}`",
+                    crate::textfile::quote(h),
+                    crate::textfile::quote(&unit)
+                ),
             })?;
             Ok(Column { index, name: name.clone(), factor }).map(|c: Column| Column { name: h.clone(), ..c })
         })

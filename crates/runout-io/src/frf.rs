@@ -21,7 +21,7 @@ use std::path::Path;
 
 /// Error naming the file, the line and what was expected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}:{line}: {message}")]
+#[error("{file}{}: {message}", if *line > 0 { format!(":{line}") } else { String::new() })]
 pub struct FrfError {
     /// The file.
     pub file: String,

@@ -18,12 +18,27 @@ pub struct TextFileError {
     pub message: String,
 }
 
-/// At most 80 characters of `text` (with `…` when cut), for messages.
+/// At most 80 characters of `text` (with `…` when cut), for messages; control characters
+/// (line breaks, tabs, NUL …) are escaped (`\n`) so that a message stays on one line.
 pub fn quote(text: &str) -> String {
-    match text.char_indices().nth(80) {
-        Some((i, _)) => format!("{}…", &text[..i]),
-        None => text.to_string(),
+    let cut = match text.char_indices().nth(80) {
+        Some((i, _)) => &text[..i],
+        None => text,
+    };
+    let mut out: String = cut
+        .chars()
+        .flat_map(|c| {
+            let escaped = c.is_control().then(|| c.escape_default());
+            escaped
+                .into_iter()
+                .flatten()
+                .chain((!c.is_control()).then_some(c))
+        })
+        .collect();
+    if cut.len() < text.len() {
+        out.push('…');
     }
+    out
 }
 
 /// Read `path` as UTF-8 text, refusing files over [`MAX_TABLE_BYTES`] (checked on the size
@@ -96,6 +111,13 @@ fn check_lines(file: &str, bytes: &[u8]) -> Result<(), TextFileError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quotes_are_short_and_on_one_line() {
+        assert_eq!(quote("a\nb\t\0c"), "a\\nb\\t\\u{0}c");
+        assert_eq!(quote(&"é".repeat(100)), format!("{}…", "é".repeat(80)));
+        assert_eq!(quote("plain µm"), "plain µm");
+    }
 
     #[test]
     fn long_lines_and_big_files_are_refused_with_a_short_quote() {

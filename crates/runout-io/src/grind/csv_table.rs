@@ -46,7 +46,8 @@ impl Table {
                 return Err(err(
                     Some(header_line),
                     format!(
-                        "unknown column `{n}` (expected some of: {})",
+                        "unknown column `{}` (expected some of: {})",
+                        crate::textfile::quote(n),
                         known.join(", ")
                     ),
                 ));
