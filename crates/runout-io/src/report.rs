@@ -33,6 +33,9 @@ pub fn chain_message(err: &(dyn Error + 'static)) -> String {
 }
 
 /// [`chain_message`] over an already walked chain (outermost first), e.g. `anyhow::Error::chain`.
+///
+/// A cause that starts with the file the message so far ends with (`analysing rec.csv` then
+/// `rec.csv:3: …`) continues it without naming the file again (`analysing rec.csv:3: …`).
 pub fn chain_of<'a>(chain: impl IntoIterator<Item = &'a (dyn Error + 'static)>) -> String {
     let mut out = String::new();
     for e in chain {
@@ -41,10 +44,16 @@ pub fn chain_of<'a>(chain: impl IntoIterator<Item = &'a (dyn Error + 'static)>) 
         if text.is_empty() || out.contains(text) {
             continue;
         }
-        if !out.is_empty() {
-            out.push_str(": ");
+        let last = out.rsplit(' ').next().unwrap_or("");
+        match text.strip_prefix(last) {
+            Some(rest) if last.len() > 1 && rest.starts_with(':') => out.push_str(rest),
+            _ => {
+                if !out.is_empty() {
+                    out.push_str(": ");
+                }
+                out.push_str(text);
+            }
         }
-        out.push_str(text);
     }
     out
 }
@@ -83,5 +92,20 @@ mod tests {
         struct Middle(#[source] std::io::Error);
         let e = Outer(Middle(std::io::Error::other("root cause")));
         assert_eq!(chain_message(&e), "outer: middle: root cause");
+    }
+
+    #[test]
+    fn a_file_named_by_the_context_is_not_repeated() {
+        #[derive(Debug, thiserror::Error)]
+        #[error("analysing {0}")]
+        struct Context(&'static str, #[source] Inner);
+        #[derive(Debug, thiserror::Error)]
+        #[error("{0}")]
+        struct Inner(&'static str);
+        let m = |c, i| chain_message(&Context(c, Inner(i)));
+        assert_eq!(m("d/r.csv", "d/r.csv:3:2: bad"), "analysing d/r.csv:3:2: bad");
+        assert_eq!(m("d/r.csv", "d/r.csv: cannot read"), "analysing d/r.csv: cannot read");
+        assert_eq!(m("d/r.csv", "d/r.csvx: other"), "analysing d/r.csv: d/r.csvx: other");
+        assert_eq!(m("a", "a: b"), "analysing a: a: b", "one letter is no file name");
     }
 }
