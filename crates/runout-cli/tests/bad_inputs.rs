@@ -2,7 +2,7 @@
 //! files, flags, configs, tables, NC programs, toolpaths, FRF tables, shank configs. Each row is
 //! run in a fresh folder holding only its input files and asserts:
 //!
-//! * the exit code (1: refused; never a panic),
+//! * the exit code (1: refused; never a panic) and an empty standard output (also with `--json -`),
 //! * that the message names the problem and where (`file:line[:column]`, the flag or the key),
 //! * that each cause is printed once (no `: `-separated part of the message repeated),
 //! * that no input file changed (a hash of every file before and after),
@@ -117,6 +117,8 @@ const ROWS: &[Row] = &[
           expect: &["teeth", "3", "4"] },
     Row { name: "peak table cell not a number", files: &[("t.csv", Edit("seed003_table1.csv", "307.9", "3o7.9"))],
           args: "identify tests {d}/t.csv --json {d}/t.json", expect: &["t.csv:7", "3o7.9"] },
+    Row { name: "JSON to stdout of a failing job", files: &[("t.csv", Edit("seed003_table1.csv", "up\n", "sideways\n"))],
+          args: "identify tests {d}/t.csv --json -", expect: &["t.csv:", "sideways"] },
     Row { name: "peak table TOML syntax", files: &[("t.toml", Edit("seed003_table1.toml", "teeth = 4", "teeth = [4"))],
           args: "identify tests {d}/t.toml --json {d}/t.json", expect: &["t.toml:3", "comma"] },
     // ---- displacement ----
@@ -167,7 +169,7 @@ const ROWS: &[Row] = &[
           args: "chip compare {d}/c.toml --json {d}/c.json", expect: &["c.toml", "folder"] },
     Row { name: "plot into a missing folder after the table", files: &[("c.toml", Example("chip/section2_5.toml"))],
           args: "chip eval {d}/c.toml --out {d}/h.csv --json {d}/e.json --plot {d}/missing/p.svg",
-          expect: &["missing/p.svg"] },
+          expect: &["missing/p.svg", "folder `{d}/missing` does not exist; create it or choose another path"] },
     // ---- grind: probe and edge tables, NC programs ----
     Row { name: "probe table with an unknown column", files: &[("probe.csv", Edit("grind/probe.csv", "angle_deg", "angle_grad")), EDGE],
           args: GRIND, expect: &["probe.csv, line 3", "unknown column `angle_grad`"] },
@@ -217,9 +219,9 @@ const ROWS: &[Row] = &[
     Row { name: "JSON over the case config", files: &[("case.toml", Example("simulate.toml"))],
           args: "simulate {d}/case.toml --json {d}/case.toml", expect: &["case.toml", "input"] },
     Row { name: "CSV into a missing folder with JSON and plot", files: &[], args: "SIM --out {d}/no/forces.csv --json {d}/sim.json --plot {d}/forces.svg",
-          expect: &["no/forces.csv"] },
+          expect: &["no/forces.csv", "No such file or directory (os error 2); check the path"] },
     Row { name: "plot onto a folder", files: &[("plot.svg", Folder)], args: "SIM --json {d}/sim.json --plot {d}/plot.svg",
-          expect: &["plot.svg"] },
+          expect: &["plot.svg", "is a folder"] },
     Row { name: "sensor FRF that is a folder", files: &[("frf.csv", Folder)],
           args: "SIM SIM_OUT --recording {d}/rec.csv --sample-rate-hz 20000 --sensor-frf {d}/frf.csv",
           expect: &["frf.csv", "folder"] },
@@ -289,6 +291,12 @@ fn check(row: &Row) -> Vec<String> {
     let mut problems = Vec::new();
     if out.status.code() != Some(1) {
         problems.push(format!("exit {:?}", out.status.code()));
+    }
+    if !out.stdout.is_empty() {
+        problems.push(format!(
+            "printed to stdout: {}",
+            String::from_utf8_lossy(&out.stdout)
+        ));
     }
     if err.contains("panicked") || !err.starts_with("error: ") {
         problems.push("not a plain `error: …` message".into());

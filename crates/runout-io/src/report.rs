@@ -10,7 +10,8 @@
 use std::error::Error;
 
 /// `error: cause: cause of the cause …` with each cause printed once: a cause whose text is
-/// already part of the message so far (because an outer `Display` included it) is skipped.
+/// already part of the message so far (because an outer `Display` included it) is skipped. An
+/// [`std::io::Error`] in the chain is printed with what to do ([`io_problem`]).
 ///
 /// ```
 /// #[derive(Debug)]
@@ -39,11 +40,16 @@ pub fn chain_message(err: &(dyn Error + 'static)) -> String {
 pub fn chain_of<'a>(chain: impl IntoIterator<Item = &'a (dyn Error + 'static)>) -> String {
     let mut out = String::new();
     for e in chain {
-        let text = e.to_string();
-        let text = text.trim();
-        if text.is_empty() || out.contains(text) {
+        let raw = e.to_string();
+        if raw.trim().is_empty() || out.contains(raw.trim()) {
             continue;
         }
+        // an operating-system error says what to do about it
+        let text = match e.downcast_ref::<std::io::Error>() {
+            Some(io) => io_problem(io),
+            None => raw,
+        };
+        let text = text.trim();
         let last = out.rsplit(' ').next().unwrap_or("");
         match text.strip_prefix(last) {
             Some(rest) if last.len() > 1 && rest.starts_with(':') => out.push_str(rest),
@@ -107,5 +113,20 @@ mod tests {
         assert_eq!(m("d/r.csv", "d/r.csv: cannot read"), "analysing d/r.csv: cannot read");
         assert_eq!(m("d/r.csv", "d/r.csvx: other"), "analysing d/r.csv: d/r.csvx: other");
         assert_eq!(m("a", "a: b"), "analysing a: a: b", "one letter is no file name");
+    }
+
+    #[test]
+    fn os_errors_in_the_chain_get_their_hint_once() {
+        #[derive(Debug, thiserror::Error)]
+        #[error("creating out.csv")]
+        struct Creating(#[source] std::io::Error);
+        #[derive(Debug, thiserror::Error)]
+        #[error("out.csv: {0}")]
+        struct Both(#[source] std::io::Error);
+        let nf = || std::io::Error::from(std::io::ErrorKind::NotFound);
+        let m = chain_message(&Creating(nf()));
+        assert!(m.starts_with("creating out.csv: ") && m.ends_with("; check the path (relative paths start at the current folder)"), "{m}");
+        let m = chain_message(&Both(nf()));
+        assert_eq!(m, format!("out.csv: {}", nf()), "already printed by the outer error");
     }
 }
