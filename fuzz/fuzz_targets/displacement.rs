@@ -8,9 +8,7 @@ use runout_core::displacement::{
     ToothFitOptions, ToothReadings,
 };
 use runout_core::Cutter;
-use runout_io::displacement::{
-    read_height_table, read_signal, read_tooth_table, SignalSection,
-};
+use runout_io::displacement::{read_height_table, read_signal, read_tooth_table, SignalSection};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 

@@ -44,10 +44,12 @@ struct Row {
     expect: &'static [&'static str],
 }
 
-const SIM: &str = "simulate --teeth 4 --diameter-mm 10 --rpm 3240 --fz-mm 0.08 --ap-mm 1 --ae-mm 2 \
+const SIM: &str =
+    "simulate --teeth 4 --diameter-mm 10 --rpm 3240 --fz-mm 0.08 --ap-mm 1 --ae-mm 2 \
                    --mode down --ktc 1889.2 --krc 806.1";
 const SIM_OUT: &str = "--out {d}/forces.csv --json {d}/sim.json --plot {d}/forces.svg";
-const IDENTIFY: &str = "identify {d}/rec.csv --config {d}/cut.toml --json {d}/id.json --plot-dir {d}/plots";
+const IDENTIFY: &str =
+    "identify {d}/rec.csv --config {d}/cut.toml --json {d}/id.json --plot-dir {d}/plots";
 const CUT: (&str, Src) = (
     "cut.toml",
     Edit("identify/cut.toml", "fz_mm = [0.05, 0.08]", "fz_mm = 0.05"),
@@ -358,10 +360,17 @@ fn a_successful_command_does_write_its_outputs() {
     let d = dir.path().to_str().unwrap();
     let line = format!("{SIM} {SIM_OUT}").replace("{d}", d);
     let out = runout().args(line.split_whitespace()).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let files = snapshot(dir.path());
     for f in ["forces.csv", "sim.json", "forces.svg"] {
-        assert!(files.contains_key(Path::new(f)), "{f} not written: {files:?}");
+        assert!(
+            files.contains_key(Path::new(f)),
+            "{f} not written: {files:?}"
+        );
     }
 }
 
@@ -376,11 +385,26 @@ fn errors_end_with_what_to_do() {
             "check the path (relative paths start at the current folder)",
         ),
         ("case file is a folder", "is a folder: expected a file"),
-        ("readings without a reading column", "the header has tooth, value"),
-        ("no time column and no rate", "(see `runout identify --help`)"),
-        ("peak that is not a number", "(see `runout identify peaks --help`)"),
-        ("unknown sensor kind", "(see `runout displacement teeth --help`)"),
-        ("signal section past the end", "inside them\n  (see `runout displacement signal --help`)"),
+        (
+            "readings without a reading column",
+            "the header has tooth, value",
+        ),
+        (
+            "no time column and no rate",
+            "(see `runout identify --help`)",
+        ),
+        (
+            "peak that is not a number",
+            "(see `runout identify peaks --help`)",
+        ),
+        (
+            "unknown sensor kind",
+            "(see `runout displacement teeth --help`)",
+        ),
+        (
+            "signal section past the end",
+            "inside them\n  (see `runout displacement signal --help`)",
+        ),
         ("bar given twice", "(see `runout grind compensate --help`)"),
         ("unknown chip model", "(see `runout chip eval --help`)"),
     ];
@@ -406,7 +430,9 @@ fn errors_end_with_what_to_do() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.starts_with("error: --fz-mm")
-            && err.trim_end().ends_with("(see `runout identify peaks --help`)"),
+            && err
+                .trim_end()
+                .ends_with("(see `runout identify peaks --help`)"),
         "{err}"
     );
 }

@@ -142,7 +142,7 @@ pub fn check_destination(path: &std::path::Path) -> Result<(), PlotError> {
     };
     if path.is_dir() {
         return Err(err(
-            "is a folder: expected a file name such as plot.svg".into(),
+            "is a folder: expected a file name such as plot.svg".into()
         ));
     }
     match path.parent() {

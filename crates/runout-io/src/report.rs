@@ -109,10 +109,23 @@ mod tests {
         #[error("{0}")]
         struct Inner(&'static str);
         let m = |c, i| chain_message(&Context(c, Inner(i)));
-        assert_eq!(m("d/r.csv", "d/r.csv:3:2: bad"), "analysing d/r.csv:3:2: bad");
-        assert_eq!(m("d/r.csv", "d/r.csv: cannot read"), "analysing d/r.csv: cannot read");
-        assert_eq!(m("d/r.csv", "d/r.csvx: other"), "analysing d/r.csv: d/r.csvx: other");
-        assert_eq!(m("a", "a: b"), "analysing a: a: b", "one letter is no file name");
+        assert_eq!(
+            m("d/r.csv", "d/r.csv:3:2: bad"),
+            "analysing d/r.csv:3:2: bad"
+        );
+        assert_eq!(
+            m("d/r.csv", "d/r.csv: cannot read"),
+            "analysing d/r.csv: cannot read"
+        );
+        assert_eq!(
+            m("d/r.csv", "d/r.csvx: other"),
+            "analysing d/r.csv: d/r.csvx: other"
+        );
+        assert_eq!(
+            m("a", "a: b"),
+            "analysing a: a: b",
+            "one letter is no file name"
+        );
     }
 
     #[test]
@@ -125,8 +138,16 @@ mod tests {
         struct Both(#[source] std::io::Error);
         let nf = || std::io::Error::from(std::io::ErrorKind::NotFound);
         let m = chain_message(&Creating(nf()));
-        assert!(m.starts_with("creating out.csv: ") && m.ends_with("; check the path (relative paths start at the current folder)"), "{m}");
+        assert!(
+            m.starts_with("creating out.csv: ")
+                && m.ends_with("; check the path (relative paths start at the current folder)"),
+            "{m}"
+        );
         let m = chain_message(&Both(nf()));
-        assert_eq!(m, format!("out.csv: {}", nf()), "already printed by the outer error");
+        assert_eq!(
+            m,
+            format!("out.csv: {}", nf()),
+            "already printed by the outer error"
+        );
     }
 }

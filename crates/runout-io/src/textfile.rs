@@ -60,10 +60,18 @@ pub fn read_text(path: &Path) -> Result<String, TextFileError> {
             ),
         )
     };
-    let f = std::fs::File::open(path).map_err(|e| err(None, format!("cannot read: {}", crate::report::io_problem(&e))))?;
-    let meta = f
-        .metadata()
-        .map_err(|e| err(None, format!("cannot read: {}", crate::report::io_problem(&e))))?;
+    let f = std::fs::File::open(path).map_err(|e| {
+        err(
+            None,
+            format!("cannot read: {}", crate::report::io_problem(&e)),
+        )
+    })?;
+    let meta = f.metadata().map_err(|e| {
+        err(
+            None,
+            format!("cannot read: {}", crate::report::io_problem(&e)),
+        )
+    })?;
     if meta.is_dir() {
         return Err(err(None, "is a folder: expected a file".into()));
     }
@@ -73,7 +81,12 @@ pub fn read_text(path: &Path) -> Result<String, TextFileError> {
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     f.take(MAX_TABLE_BYTES + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| err(None, format!("cannot read: {}", crate::report::io_problem(&e))))?;
+        .map_err(|e| {
+            err(
+                None,
+                format!("cannot read: {}", crate::report::io_problem(&e)),
+            )
+        })?;
     if bytes.len() as u64 > MAX_TABLE_BYTES {
         return Err(too_big(bytes.len() as u64));
     }

@@ -13,7 +13,10 @@ fn printed_once(e: &(dyn Error + 'static), cause: &str, hint: &str) {
     assert!(m.ends_with(hint), "{m}");
     // the rule itself: either the text or the source, not both
     if let Some(s) = e.source() {
-        assert!(!e.to_string().contains(&s.to_string()), "{e} and its source {s}");
+        assert!(
+            !e.to_string().contains(&s.to_string()),
+            "{e} and its source {s}"
+        );
     }
 }
 
@@ -30,24 +33,44 @@ fn os_errors_of_every_reader_are_printed_once_with_what_to_do() {
     assert!(matches!(e, RecordingError::Io { .. }));
     printed_once(&e, is_dir, "expected a file, got a folder");
     let e = Recording::read(&missing, &ReadOptions::default()).unwrap_err();
-    printed_once(&e, not_found, "check the path (relative paths start at the current folder)");
+    printed_once(
+        &e,
+        not_found,
+        "check the path (relative paths start at the current folder)",
+    );
 
     // every whole-file reader: text files (configs, toolpaths, NC, tables), displacement
     // tables, FRF tables, peak tables, chip case files
     let e = runout_io::textfile::read_text(folder).unwrap_err();
     printed_once(&e, "is a folder", "expected a file");
     let e = runout_io::textfile::read_text(&missing).unwrap_err();
-    printed_once(&e, not_found, "check the path (relative paths start at the current folder)");
+    printed_once(
+        &e,
+        not_found,
+        "check the path (relative paths start at the current folder)",
+    );
     let e = runout_io::displacement::read_height_table(folder).unwrap_err();
     printed_once(&e, "is a folder", "expected a CSV file");
     let e = runout_io::displacement::read_height_table(&missing).unwrap_err();
-    printed_once(&e, not_found, "check the path (relative paths start at the current folder)");
+    printed_once(
+        &e,
+        not_found,
+        "check the path (relative paths start at the current folder)",
+    );
     let e = runout_io::frf::read_frf(&missing).unwrap_err();
-    printed_once(&e, not_found, "check the path (relative paths start at the current folder)");
+    printed_once(
+        &e,
+        not_found,
+        "check the path (relative paths start at the current folder)",
+    );
     let e = runout_io::peak_table::read_peak_table(folder).unwrap_err();
     printed_once(&e, "is a folder", "expected a file");
     let e = runout_io::config::chip::read_cases(&missing).unwrap_err();
-    printed_once(&e, not_found, "check the path (relative paths start at the current folder)");
+    printed_once(
+        &e,
+        not_found,
+        "check the path (relative paths start at the current folder)",
+    );
     let e = runout_io::toolpath::read_toolpath(folder).unwrap_err();
     printed_once(&e, "is a folder", "expected a file");
 }
@@ -71,7 +94,10 @@ fn io_errors_in_messages_carry_no_source() {
     ];
     for e in errors {
         assert!(e.source().is_none(), "{e}");
-        assert!(e.to_string().ends_with("check the file's permissions"), "{e}");
+        assert!(
+            e.to_string().ends_with("check the file's permissions"),
+            "{e}"
+        );
     }
     assert_eq!(
         io_problem(&std::io::Error::other("disk on fire")),

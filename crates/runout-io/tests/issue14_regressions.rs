@@ -37,7 +37,10 @@ fn grind_header_line_counts_comment_lines() {
     let e = read_probe_csv("# probe\n# more\nlayer,u_mm,angle_grad\n0,1,2\n", "p.csv")
         .unwrap_err()
         .to_string();
-    assert!(e.starts_with("p.csv, line 3: unknown column `angle_grad`"), "{e}");
+    assert!(
+        e.starts_with("p.csv, line 3: unknown column `angle_grad`"),
+        "{e}"
+    );
 }
 
 /// A gap in a raw signal was reported at the first sample (its step differed from the mean
@@ -54,10 +57,18 @@ fn a_signal_gap_is_reported_where_it_is() {
     let e = read_signal(&p, &SignalSection::default())
         .unwrap_err()
         .to_string();
-    assert!(e.contains("s.csv:5: column `time_s`: time step 7.000000e-3 s"), "{e}");
+    assert!(
+        e.contains("s.csv:5: column `time_s`: time step 7.000000e-3 s"),
+        "{e}"
+    );
     // evenly spaced with jitter well under half a step still reads
     let rows: String = (0..50)
-        .map(|i| format!("{},{i}\n", i as f64 * 1e-3 + if i % 2 == 0 { 1e-5 } else { 0.0 }))
+        .map(|i| {
+            format!(
+                "{},{i}\n",
+                i as f64 * 1e-3 + if i % 2 == 0 { 1e-5 } else { 0.0 }
+            )
+        })
         .collect();
     std::fs::write(&p, format!("time_s,disp_a_um\n{rows}")).unwrap();
     let s = read_signal(&p, &SignalSection::default()).unwrap();
@@ -75,5 +86,8 @@ fn an_empty_section_gives_the_time_range() {
         ..Default::default()
     };
     let e = read_signal(&p, &section).unwrap_err().to_string();
-    assert!(e.contains("run from 0 s to 0.002 s: choose --from-s/--to-s"), "{e}");
+    assert!(
+        e.contains("run from 0 s to 0.002 s: choose --from-s/--to-s"),
+        "{e}"
+    );
 }
