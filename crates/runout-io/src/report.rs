@@ -78,7 +78,6 @@ pub fn io_problem(e: &std::io::Error) -> String {
         K::NotFound => "check the path (relative paths start at the current folder)",
         K::IsADirectory => "expected a file, got a folder",
         K::PermissionDenied => "check the file's permissions",
-        K::InvalidData => "the file is not UTF-8 text: save it as UTF-8",
         _ => return e.to_string(),
     };
     format!("{e}; {hint}")

@@ -262,7 +262,7 @@ fn check<T, E: std::fmt::Display>(
 }
 
 proptest! {
-    #![proptest_config(config(2048))]
+    #![proptest_config(config(8192))]
 
     #[test]
     fn recordings(bytes in mutated(RECORDINGS)) {
@@ -309,7 +309,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(config(1024))]
+    #![proptest_config(config(4096))]
 
     #[test]
     fn simulate_and_identify_configs(bytes in mutated(CONFIGS)) {
@@ -436,7 +436,7 @@ proptest! {
 
 proptest! {
     // each case writes a file: fewer cases
-    #![proptest_config(config(512))]
+    #![proptest_config(config(2048))]
 
     #[test]
     fn displacement_tables(bytes in mutated(DISPLACEMENT)) {
