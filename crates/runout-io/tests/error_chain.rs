@@ -133,3 +133,30 @@ fn the_chain_printer_drops_repeated_causes_only() {
     let plain = Wrap("outer", Box::new(Wrap("middle", root(), false)), false);
     assert_eq!(chain_message(&plain), "outer: middle: root cause");
 }
+
+/// A bad value given as a flag is named as the flag (where the user typed it), a bad value in a
+/// file as the file's key.
+#[test]
+fn config_errors_name_the_flag_or_the_key() {
+    use runout_io::config::ConfigError;
+    let key = |source: &str, key: &str| {
+        ConfigError::Key {
+            source_name: source.into(),
+            key: key.into(),
+            message: "expected > 0, got -1".into(),
+        }
+        .to_string()
+    };
+    assert_eq!(
+        key("command line", "fz_mm"),
+        "--fz-mm: expected > 0, got -1"
+    );
+    assert_eq!(
+        key("command line", "from_s/to_s"),
+        "--from-s/--to-s: expected > 0, got -1"
+    );
+    assert_eq!(
+        key("cut.toml", "fz_mm"),
+        "cut.toml: key `fz_mm`: expected > 0, got -1"
+    );
+}
