@@ -213,7 +213,7 @@ const ROWS: &[Row] = &[
           expect: &["diameter_mm", "got 0"] },
     // ---- simulate ----
     Row { name: "zero teeth", files: &[], args: "simulate --teeth 0 --diameter-mm 10 --rpm 3240 --fz-mm 0.08 --ap-mm 1 --ae-mm 2 --mode down --ktc 1889.2 --krc 806.1 --json {d}/sim.json",
-          expect: &["--teeth: expected an integer in [1, 360]", "got 0"] },
+          expect: &["--teeth (key `teeth`): expected an integer in [1, 360]", "got 0"] },
     Row { name: "unknown milling mode", files: &[], args: "simulate --teeth 4 --diameter-mm 10 --rpm 3240 --fz-mm 0.08 --ap-mm 1 --ae-mm 2 --mode sideways --ktc 1889.2 --krc 806.1 --json {d}/sim.json",
           expect: &["mode", "sideways"] },
     Row { name: "case config with a non-finite value", files: &[("case.toml", Edit("simulate.toml", "rpm = 3240.0", "rpm = nan"))],

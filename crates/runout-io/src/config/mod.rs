@@ -32,7 +32,7 @@ pub enum ConfigError {
         /// The TOML parser's message.
         message: String,
     },
-    /// A key has a bad value (from the command line: named as its flag, `--fz-mm`).
+    /// A key has a bad value (from the command line: named as its flag too, `--fz-mm`).
     #[error("{}", key_error(.source_name, .key, .message))]
     Key {
         /// File name or "command line".
@@ -54,14 +54,15 @@ pub enum ConfigError {
     },
 }
 
-/// `file: key \`fz_mm\`: …`, or `command line: --fz-mm: …` for a flag.
+/// `file: key \`fz_mm\`: …`, or `--fz-mm (key \`fz_mm\`): …` for a flag (the same key in a
+/// config file).
 fn key_error(source_name: &str, key: &str, message: &str) -> String {
     if source_name == "command line" {
         let flags: Vec<String> = key
             .split('/')
             .map(|k| format!("--{}", k.replace('_', "-")))
             .collect();
-        format!("{}: {message}", flags.join("/"))
+        format!("{} (key `{key}`): {message}", flags.join("/"))
     } else {
         format!("{source_name}: key `{key}`: {message}")
     }
