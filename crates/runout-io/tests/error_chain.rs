@@ -149,11 +149,11 @@ fn config_errors_name_the_flag_or_the_key() {
     };
     assert_eq!(
         key("command line", "fz_mm"),
-        "--fz-mm: expected > 0, got -1"
+        "--fz-mm (key `fz_mm`): expected > 0, got -1"
     );
     assert_eq!(
         key("command line", "from_s/to_s"),
-        "--from-s/--to-s: expected > 0, got -1"
+        "--from-s/--to-s (key `from_s/to_s`): expected > 0, got -1"
     );
     assert_eq!(
         key("cut.toml", "fz_mm"),
