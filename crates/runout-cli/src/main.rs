@@ -97,10 +97,39 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_message(&e));
             ExitCode::from(1)
         }
     }
+}
+
+/// The error and its causes, each printed once ([`runout_io::report::chain_of`]); an error that
+/// names a flag ends with where the flags are described (`see \`runout identify --help\``).
+fn error_message(e: &anyhow::Error) -> String {
+    let mut m = runout_io::report::chain_of(e.chain());
+    let names_flag = m
+        .split("--")
+        .skip(1)
+        .any(|rest| rest.starts_with(|c: char| c.is_ascii_lowercase()));
+    if names_flag && !m.contains("--help") {
+        m.push_str(&format!("\n  (see `{} --help`)", command_path()));
+    }
+    m
+}
+
+/// `runout identify peaks`: the program and the subcommands given on the command line.
+fn command_path() -> String {
+    use clap::CommandFactory;
+    let mut cmd = Cli::command();
+    let mut path = vec!["runout".to_string()];
+    for a in std::env::args().skip(1) {
+        let Some(sub) = cmd.find_subcommand(&a).cloned() else {
+            break;
+        };
+        path.push(a);
+        cmd = sub;
+    }
+    path.join(" ")
 }
 
 #[cfg(test)]

@@ -108,13 +108,24 @@ fn open_table(input: TableInput<'_>) -> Result<(Table, CsvReader<'_>), TableErro
     let (file, reader): (String, Box<dyn std::io::Read + '_>) = match input {
         TableInput::Path(path) => {
             let file = path.display().to_string();
-            let f = std::fs::File::open(path).map_err(|e| TableError::File {
+            let unreadable = |e: &std::io::Error| TableError::File {
                 file: file.clone(),
-                message: csv::Error::from(e).to_string(),
-            })?;
+                message: format!("cannot read: {}", crate::report::io_problem(e)),
+            };
+            let f = std::fs::File::open(path).map_err(|e| unreadable(&e))?;
+            if f.metadata().map_err(|e| unreadable(&e))?.is_dir() {
+                return Err(TableError::File {
+                    file,
+                    message: "is a folder: expected a CSV file".into(),
+                });
+            }
             (file, Box::new(f))
         }
         TableInput::Reader { name, reader, .. } => (name.to_string(), reader),
+    };
+    let unreadable = |e: &std::io::Error| TableError::File {
+        file: file.clone(),
+        message: format!("cannot read: {}", crate::report::io_problem(e)),
     };
     let mut rdr = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
@@ -123,9 +134,13 @@ fn open_table(input: TableInput<'_>) -> Result<(Table, CsvReader<'_>), TableErro
         .from_reader(reader);
     let headers: Vec<String> = rdr
         .headers()
-        .map_err(|e| TableError::Header {
-            file: file.clone(),
-            message: e.to_string(),
+        .map_err(|e| match e.kind() {
+            csv::ErrorKind::Io(e) => unreadable(e),
+            _ => TableError::Row {
+                file: file.clone(),
+                line: e.position().map_or(1, |p| p.line()),
+                message: format!("header: {}", csv_problem(&e)),
+            },
         })?
         .iter()
         .map(|h| h.trim().to_ascii_lowercase())
@@ -145,12 +160,34 @@ fn next_record<R: std::io::Read>(
 ) -> Result<Option<(u64, csv::StringRecord)>, TableError> {
     match records.next() {
         None => Ok(None),
-        Some(Err(e)) => Err(TableError::Row {
-            file: t.file.clone(),
-            line: e.position().map_or(0, |p| p.line()),
-            message: e.to_string(),
+        Some(Err(e)) => Err(match e.position() {
+            Some(p) => TableError::Row {
+                file: t.file.clone(),
+                line: p.line(),
+                message: csv_problem(&e),
+            },
+            None => TableError::File {
+                file: t.file.clone(),
+                message: csv_problem(&e),
+            },
         }),
         Some(Ok(rec)) => Ok(Some((rec.position().map_or(0, |p| p.line()), rec))),
+    }
+}
+
+/// A CSV reader's error without its position (the caller names the line), with what to do.
+fn csv_problem(e: &csv::Error) -> String {
+    match e.kind() {
+        csv::ErrorKind::Io(e) => format!("cannot read: {}", crate::report::io_problem(e)),
+        csv::ErrorKind::Utf8 { .. } => {
+            "not UTF-8 text (a binary file, or another encoding: save it as UTF-8)".into()
+        }
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!(
+            "{len} fields, expected {expected_len} as in the header (a missing or extra separator)"
+        ),
+        _ => e.to_string(),
     }
 }
 
@@ -203,7 +240,9 @@ impl Table {
             let factor = q.unit_factor(unit).ok_or_else(|| TableError::Header {
                 file: self.file.clone(),
                 message: format!(
-                    "column `{h}`: unit `{unit}` is not a unit of {q} (e.g. `{base}_{}`)",
+                    "column `{}`: unit `{}` is not a unit of {q} (e.g. `{base}_{}`)",
+                    crate::textfile::quote(h),
+                    crate::textfile::quote(unit),
                     q.unit().replace('µ', "u")
                 ),
             })?;
@@ -232,7 +271,7 @@ impl Table {
             file: self.file.clone(),
             message: format!(
                 "no column {what}; the header has {}",
-                self.headers.join(", ")
+                crate::textfile::quote(&self.headers.join(", "))
             ),
         }
     }
@@ -477,7 +516,11 @@ pub fn read_signal<'a>(
         .map(|(index, h, name, unit)| {
             let factor = Quantity::LengthMm.unit_factor(&unit).ok_or_else(|| TableError::Header {
                 file: t.file.clone(),
-                message: format!("column `{h}`: expected `disp_<name>_<unit>` with a length unit (um, mm), got unit `{unit}`"),
+                message: format!(
+                    "column `{}`: expected `disp_<name>_<unit>` with a length unit (um, mm), got unit `{}`",
+                    crate::textfile::quote(h),
+                    crate::textfile::quote(&unit)
+                ),
             })?;
             Ok(Column { index, name: name.clone(), factor }).map(|c: Column| Column { name: h.clone(), ..c })
         })
@@ -497,14 +540,18 @@ pub fn read_signal<'a>(
     let mut pulse = pulse_col.as_ref().map(|_| Vec::new());
     let mut encoder = encoder_col.as_ref().map(|_| Vec::new());
     let mut rows = 0usize;
+    let mut span: Option<(f64, f64)> = None; // first and last time read
+    let mut stopped_early = false;
     let mut records = rdr.records();
     while let Some((line, rec)) = next_record(&t, &mut records)? {
         rows += 1;
         let ti = t.cell(line, &rec, &time)?;
+        span = Some((span.map_or(ti, |s| s.0), ti));
         if ti < from {
             continue;
         }
         if ti > to {
+            stopped_early = true;
             break;
         }
         if times.len() == section.max_samples {
@@ -539,9 +586,13 @@ pub fn read_signal<'a>(
         return Err(TableError::File {
             file: t.file.clone(),
             message: format!(
-                "no sample in the selected section [{}, {}] s",
+                "no sample in the selected section [{}, {}] s; the signal's times run from {} s \
+                 to {}{} s: choose --from-s/--to-s (s) inside them",
                 section.from_s.map_or("start".into(), |v| v.to_string()),
-                section.to_s.map_or("end".into(), |v| v.to_string())
+                section.to_s.map_or("end".into(), |v| v.to_string()),
+                span.map_or(0.0, |s| s.0),
+                if stopped_early { "at least " } else { "" },
+                span.map_or(0.0, |s| s.1),
             ),
         });
     }
@@ -584,11 +635,8 @@ fn check_time_grid(
     if dt.is_nan() || dt <= 0.0 {
         return Err(t.cell_error(lines[n - 1], col, "time does not increase".into()));
     }
-    // a gap, a jump back or a repeated time first shows as one step far from the mean step:
-    // name that line rather than where the accumulated drift leaves the grid
     for i in 1..n {
-        let step = times[i] - times[i - 1];
-        if step <= 0.0 {
+        if times[i] <= times[i - 1] {
             return Err(t.cell_error(
                 lines[i],
                 col,
@@ -600,12 +648,25 @@ fn check_time_grid(
                 ),
             ));
         }
-        if (step - dt).abs() > 0.5 * dt {
+    }
+    // a gap or a jump first shows as one step far from the typical step (the median of at most
+    // 4096 steps spread over the signal): name that line rather than where the accumulated
+    // drift leaves the grid
+    let stride = ((n - 1) / 4096).max(1);
+    let mut sample: Vec<f64> = (1..n)
+        .step_by(stride)
+        .map(|i| times[i] - times[i - 1])
+        .collect();
+    sample.sort_by(f64::total_cmp);
+    let typical = sample[sample.len() / 2];
+    for i in 1..n {
+        let step = times[i] - times[i - 1];
+        if (step - typical).abs() > 0.5 * typical {
             return Err(t.cell_error(
                 lines[i],
                 col,
                 format!(
-                    "time step {step:.6e} s from the previous sample (line {}) differs from the mean step {dt:.6e} s: samples must be evenly spaced without gaps (not on a constant-rate grid)",
+                    "time step {step:.6e} s from the previous sample (line {}) differs from the typical step {typical:.6e} s: samples must be evenly spaced without gaps (not on a constant-rate grid)",
                     lines[i - 1]
                 ),
             ));

@@ -21,7 +21,7 @@ use std::path::Path;
 
 /// Error naming the file, the line and what was expected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}:{line}: {message}")]
+#[error("{file}{}: {message}", if *line > 0 { format!(":{line}") } else { String::new() })]
 pub struct FrfError {
     /// The file.
     pub file: String,
@@ -34,10 +34,10 @@ pub struct FrfError {
 /// Read an FRF table from a file (see the module docs).
 pub fn read_frf(path: &Path) -> Result<MeasuringChain, FrfError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| FrfError {
+    let text = crate::textfile::read_text(path).map_err(|e| FrfError {
         file: file.clone(),
-        line: 0,
-        message: format!("cannot read the FRF file: {e}"),
+        line: e.line.unwrap_or(0),
+        message: format!("FRF table: {}", e.message),
     })?;
     parse_frf(&file, &text)
 }

@@ -16,6 +16,7 @@ pub mod lineplot;
 pub mod peak_table;
 pub mod plot;
 pub mod recording;
+pub mod report;
 pub mod textfile;
 pub mod toolpath;
 pub mod units;

@@ -82,6 +82,7 @@ macro_rules! render_plot {
         $crate::plot::ensure_font();
         let p = final_path.display().to_string();
         let format = $crate::plot::format_of(final_path)?;
+        $crate::plot::check_destination(final_path)?;
         // drawn into a temporary file next to the destination (same extension: the bitmap
         // backend picks the encoder by it) and renamed when complete: never half-written
         let tmp = $crate::plot::partial_path(final_path);
@@ -121,7 +122,7 @@ macro_rules! render_plot {
                 let _ = std::fs::remove_file(&tmp);
                 $crate::plot::PlotError::Draw {
                     path: p.clone(),
-                    message: e.to_string(),
+                    message: format!("cannot write: {}", $crate::report::io_problem(&e)),
                 }
             }),
             Err(e) => {
@@ -130,6 +131,27 @@ macro_rules! render_plot {
             }
         }
     }};
+}
+
+/// A plot can be written to `path`: its folder exists and it is not a folder itself (checked
+/// before drawing, so the message says so rather than the drawing backend's error).
+pub fn check_destination(path: &std::path::Path) -> Result<(), PlotError> {
+    let err = |message: String| PlotError::Draw {
+        path: path.display().to_string(),
+        message,
+    };
+    if path.is_dir() {
+        return Err(err(
+            "is a folder: expected a file name such as plot.svg".into()
+        ));
+    }
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => Err(err(format!(
+            "cannot write: folder `{}` does not exist; create it or choose another path",
+            dir.display()
+        ))),
+        _ => Ok(()),
+    }
 }
 
 /// Temporary file for drawing `path`: `.NAME.partial-PID.EXT` in the same folder.

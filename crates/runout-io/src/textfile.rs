@@ -18,12 +18,27 @@ pub struct TextFileError {
     pub message: String,
 }
 
-/// At most 80 characters of `text` (with `…` when cut), for messages.
+/// At most 80 characters of `text` (with `…` when cut), for messages; control characters
+/// (line breaks, tabs, NUL …) are escaped (`\n`) so that a message stays on one line.
 pub fn quote(text: &str) -> String {
-    match text.char_indices().nth(80) {
-        Some((i, _)) => format!("{}…", &text[..i]),
-        None => text.to_string(),
+    let cut = match text.char_indices().nth(80) {
+        Some((i, _)) => &text[..i],
+        None => text,
+    };
+    let mut out: String = cut
+        .chars()
+        .flat_map(|c| {
+            let escaped = c.is_control().then(|| c.escape_default());
+            escaped
+                .into_iter()
+                .flatten()
+                .chain((!c.is_control()).then_some(c))
+        })
+        .collect();
+    if cut.len() < text.len() {
+        out.push('…');
     }
+    out
 }
 
 /// Read `path` as UTF-8 text, refusing files over [`MAX_TABLE_BYTES`] (checked on the size
@@ -45,12 +60,20 @@ pub fn read_text(path: &Path) -> Result<String, TextFileError> {
             ),
         )
     };
-    let f = std::fs::File::open(path).map_err(|e| err(None, format!("cannot read: {e}")))?;
-    let meta = f
-        .metadata()
-        .map_err(|e| err(None, format!("cannot read: {e}")))?;
+    let f = std::fs::File::open(path).map_err(|e| {
+        err(
+            None,
+            format!("cannot read: {}", crate::report::io_problem(&e)),
+        )
+    })?;
+    let meta = f.metadata().map_err(|e| {
+        err(
+            None,
+            format!("cannot read: {}", crate::report::io_problem(&e)),
+        )
+    })?;
     if meta.is_dir() {
-        return Err(err(None, "is a folder, expected a file".into()));
+        return Err(err(None, "is a folder: expected a file".into()));
     }
     if meta.len() > MAX_TABLE_BYTES {
         return Err(too_big(meta.len()));
@@ -58,7 +81,12 @@ pub fn read_text(path: &Path) -> Result<String, TextFileError> {
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     f.take(MAX_TABLE_BYTES + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| err(None, format!("cannot read: {e}")))?;
+        .map_err(|e| {
+            err(
+                None,
+                format!("cannot read: {}", crate::report::io_problem(&e)),
+            )
+        })?;
     text_from_bytes(&file, bytes)
 }
 
@@ -114,6 +142,13 @@ fn check_lines(file: &str, bytes: &[u8]) -> Result<(), TextFileError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quotes_are_short_and_on_one_line() {
+        assert_eq!(quote("a\nb\t\0c"), "a\\nb\\t\\u{0}c");
+        assert_eq!(quote(&"é".repeat(100)), format!("{}…", "é".repeat(80)));
+        assert_eq!(quote("plain µm"), "plain µm");
+    }
 
     #[test]
     fn long_lines_and_big_files_are_refused_with_a_short_quote() {

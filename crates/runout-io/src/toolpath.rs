@@ -41,12 +41,12 @@ pub struct Toolpath {
 #[derive(Debug, thiserror::Error)]
 pub enum ToolpathError {
     /// The file could not be read.
-    #[error("{file}: {source}")]
+    #[error("{file}: cannot read: {}", crate::report::io_problem(.error))]
     Io {
         /// The file.
         file: String,
-        /// The I/O error.
-        source: std::io::Error,
+        /// The I/O error. (part of the message, not a `source()`: printed once)
+        error: std::io::Error,
     },
     /// A malformed statement.
     #[error("{file}:{line}: {message}")]

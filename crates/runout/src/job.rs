@@ -121,9 +121,9 @@ impl Source {
     ) -> Result<RecordingReader<Box<dyn BufRead + Send>>, RecordingError> {
         match &self.kind {
             Kind::Path(p) => {
-                let f = std::fs::File::open(p).map_err(|source| RecordingError::Io {
+                let f = std::fs::File::open(p).map_err(|error| RecordingError::Io {
                     file: self.name.clone(),
-                    source,
+                    error,
                 })?;
                 let size = f.metadata().ok().map(|m| m.len());
                 let src: Box<dyn BufRead + Send> =

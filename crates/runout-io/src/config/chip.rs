@@ -137,12 +137,12 @@ fn default_revolutions() -> f64 {
 #[derive(Debug, thiserror::Error)]
 pub enum ChipConfigError {
     /// Unreadable file.
-    #[error("{file}: {source}")]
+    #[error("{file}: cannot read: {}", crate::report::io_problem(.error))]
     Io {
         /// File.
         file: String,
-        /// Cause.
-        source: std::io::Error,
+        /// Cause. (part of the message, not a `source()`: printed once)
+        error: std::io::Error,
     },
     /// TOML/serde error (with line and column).
     #[error("{file}: {message}")]

@@ -32,8 +32,8 @@ pub enum ConfigError {
         /// The TOML parser's message.
         message: String,
     },
-    /// A key has a bad value.
-    #[error("{source_name}: key `{key}`: {message}")]
+    /// A key has a bad value (from the command line: named as its flag too, `--fz-mm`).
+    #[error("{}", key_error(.source_name, .key, .message))]
     Key {
         /// File name or "command line".
         source_name: String,
@@ -52,6 +52,20 @@ pub enum ConfigError {
         /// What it is.
         what: String,
     },
+}
+
+/// `file: key \`fz_mm\`: …`, or `--fz-mm (key \`fz_mm\`): …` for a flag (the same key in a
+/// config file).
+fn key_error(source_name: &str, key: &str, message: &str) -> String {
+    if source_name == "command line" {
+        let flags: Vec<String> = key
+            .split('/')
+            .map(|k| format!("--{}", k.replace('_', "-")))
+            .collect();
+        format!("{} (key `{key}`): {message}", flags.join("/"))
+    } else {
+        format!("{source_name}: key `{key}`: {message}")
+    }
 }
 
 /// One layer of key → value settings with its origin (file name or "command line").

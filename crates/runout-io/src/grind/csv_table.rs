@@ -38,7 +38,11 @@ impl Table {
             .headers()
             .map_err(|e| err(None, format!("cannot read the header: {e}")))?
             .clone();
-        let header_line = headers.position().map_or(1, |p| p.line() as usize);
+        // the reader's position of the header does not count the comment lines before it
+        let header_line = text
+            .lines()
+            .position(|l| !l.trim().is_empty() && !l.starts_with('#'))
+            .map_or(1, |i| i + 1);
         let names: Vec<String> = headers.iter().map(|h| h.to_ascii_lowercase()).collect();
         let mut index = HashMap::new();
         for (k, n) in names.iter().enumerate() {
@@ -46,7 +50,8 @@ impl Table {
                 return Err(err(
                     Some(header_line),
                     format!(
-                        "unknown column `{n}` (expected some of: {})",
+                        "unknown column `{}` (expected some of: {})",
+                        crate::textfile::quote(n),
                         known.join(", ")
                     ),
                 ));

@@ -4,13 +4,14 @@
 /// An error while reading a recording.
 #[derive(Debug, thiserror::Error)]
 pub enum RecordingError {
-    /// The operating system could not read the file.
-    #[error("{file}: cannot read: {source}")]
+    /// The operating system could not read the file. The cause is part of the message (with
+    /// what to do), not a separate `source()` (`crate::report`: printed once).
+    #[error("{file}: cannot read: {}", crate::report::io_problem(.error))]
     Io {
         /// The file.
         file: String,
         /// The I/O error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file has no content at all (or only blank lines).
     #[error("{file}: the file is empty (expected a header row, then data rows)")]

@@ -92,7 +92,9 @@ impl ReadOptions {
             if !(f.is_finite() && f > 0.0) {
                 return Err(RecordingError::Option {
                     file: file.into(),
-                    message: format!("sample rate must be a positive number of Hz, got {f}"),
+                    message: format!(
+                        "sample rate must be a positive number of Hz, got {f} (--sample-rate-hz / `sample_rate_hz`)"
+                    ),
                 });
             }
         }

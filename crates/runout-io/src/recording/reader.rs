@@ -36,9 +36,9 @@ impl<R: BufRead> LineSource<R> {
         let n = (&mut self.src)
             .take(MAX_LINE_BYTES)
             .read_until(b'\n', buf)
-            .map_err(|source| RecordingError::Io {
+            .map_err(|error| RecordingError::Io {
                 file: self.file.clone(),
-                source,
+                error,
             })?;
         if n == 0 {
             return Ok(None);
@@ -135,9 +135,9 @@ impl RecordingReader<BufReader<File>> {
     pub fn open(path: impl AsRef<Path>, options: &ReadOptions) -> Result<Self> {
         let path = path.as_ref();
         let file = path.display().to_string();
-        let f = File::open(path).map_err(|source| RecordingError::Io {
+        let f = File::open(path).map_err(|error| RecordingError::Io {
             file: file.clone(),
-            source,
+            error,
         })?;
         let mut r = Self::from_reader(BufReader::with_capacity(1 << 16, f), &file, options)?;
         r.info.file_bytes = std::fs::metadata(path).ok().map(|m| m.len());
