@@ -60,7 +60,7 @@ pub use mean_force::{
     calibrate_mean_forces, immersion_integrals, MeanForceCalibration, MeanForces,
 };
 pub use model::{
-    coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel,
+    coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel, NB, ND,
 };
 pub use multi_test::{analyse_tests, MultiTestResult, PeakTest, TestResult};
 pub use peak_coefficients::{coefficients_at_peak, PeakCoefficients};

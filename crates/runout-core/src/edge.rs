@@ -1,0 +1,162 @@
+//! One per-disk edge geometry and engagement table for every force kernel (issue 12).
+//!
+//! Both [`crate::ForceModel::simulate`] and [`crate::identify::RevolutionModel`] consume an
+//! [`EdgeTable`]: a change of the cutter model (profile, lead angle, engagement) happens here
+//! and only here.
+//!
+//! Discretisation (Engin & Altintas 2001, "Mechanics and dynamics of general milling cutters,
+//! Part I: helical end mills", Int. J. Mach. Tools Manuf. 41, §2–3; Lee & Altintas 1996,
+//! "Prediction of ball-end milling forces from orthogonal cutting data", IJMTM 36): the flutes are
+//! cut into `disks` axial slices of height dz = a_p/disks at mid-heights z_j = (j + ½)·dz
+//! measured from the tip. Per disk:
+//!
+//! * R(z_j) — the envelope radius ([`Cutter::radius_at`]);
+//! * κ(z_j) — the axial immersion (lead) angle ([`Cutter::lead_angle`]); the uncut chip
+//!   thickness normal to the edge is h·sin κ and the chip width (edge length of the disk,
+//!   E&A's db) is dz / sin κ, so the shear force K_c·(h sin κ)·(dz/sin κ) = K_c·h·dz does not
+//!   depend on κ while the edge force K_e·dz/sin κ does;
+//! * the immersion window [φ_st(z), φ_ex(z)] — a_p is measured from the tip and a_e from the
+//!   wall *at that height*: the previous pass of the same tool, a_e beside this one, left its
+//!   wall at R(z) − a_e, so up milling cuts φ ∈ [0, arccos(1 − a_e/R(z))] and down milling
+//!   φ ∈ [π − arccos(1 − a_e/R(z)), π]; where a_e ≥ 2R(z) (the bottom of a ball at small a_p)
+//!   the disk cuts a full slot [0, π]. Explicit entry/exit angles apply to every disk.
+//!
+//! Per (disk, tooth): ψ_i(z_j) ([`Cutter::tooth_angle`], constant lead or constant helix) and
+//! its sine and cosine. Runout enters as today through R_i(z) = |R(z)·u(ψ_i(z)) + e(z)|.
+//!
+//! For a flat end mill sin κ = 1 and cos κ = 0 exactly and the window is the cut's, so every
+//! kernel reproduces the cylindrical model bit for bit.
+
+use crate::cut::Cut;
+use crate::cutter::Cutter;
+
+/// Geometry of one axial disk.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Disk {
+    /// Mid-height z_j above the tip (mm).
+    pub z: f64,
+    /// Envelope radius R(z_j) (mm).
+    pub radius: f64,
+    /// sin κ(z_j).
+    pub sin_kappa: f64,
+    /// cos κ(z_j).
+    pub cos_kappa: f64,
+    /// Disk height dz (mm).
+    pub dz: f64,
+    /// Chip width / edge length of the disk, db = dz / sin κ (mm).
+    pub db: f64,
+    /// Entry immersion angle φ_st(z_j) (rad).
+    pub entry: f64,
+    /// Window width φ_ex(z_j) − φ_st(z_j) (rad).
+    pub width: f64,
+}
+
+/// Geometry of one (disk, tooth) edge element.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Element {
+    /// ψ_i(z_j) (rad).
+    pub psi: f64,
+    /// cos ψ_i(z_j).
+    pub cos_psi: f64,
+    /// sin ψ_i(z_j).
+    pub sin_psi: f64,
+}
+
+/// The per-disk and per-(disk, tooth) table (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EdgeTable {
+    teeth: usize,
+    disks: Vec<Disk>,
+    elements: Vec<Element>,
+    flat: bool,
+}
+
+impl EdgeTable {
+    /// Table of `disks` (≥ 1) disks over the cut's a_p for `cutter`.
+    ///
+    /// ```
+    /// use runout_core::{edge::EdgeTable, Cut, Cutter, MillingMode, RadiusProfile};
+    /// let ball = Cutter::new(6.0, vec![std::f64::consts::TAU / 3.0; 3], 30.0, 20.0, RadiusProfile::Ball).unwrap();
+    /// let cut = Cut::new(10400.0, 0.05, 0.2).unwrap().radial(0.125, MillingMode::Down, &ball).unwrap();
+    /// let t = EdgeTable::new(&ball, &cut, 4);
+    /// let top = t.disk(3);
+    /// // z = 0.175 mm: R(z) = sqrt(R² − (R − z)²), window arccos(1 − a_e/R(z))
+    /// let r = (9.0f64 - 2.825f64.powi(2)).sqrt();
+    /// assert!((top.radius - r).abs() < 1e-12);
+    /// assert!((top.width - (1.0 - 0.125 / r).acos()).abs() < 1e-12);
+    /// assert!((top.db * top.sin_kappa - top.dz).abs() < 1e-15);
+    /// ```
+    pub fn new(cutter: &Cutter, cut: &Cut, disks: usize) -> Self {
+        let disks = disks.max(1);
+        let k = cutter.teeth();
+        let dz = cut.ap() / disks as f64;
+        let disk_rows: Vec<Disk> = (0..disks)
+            .map(|j| {
+                let z = (j as f64 + 0.5) * dz;
+                let (sk, ck) = cutter.lead_sin_cos(z);
+                let (st, ex) = cut.immersion_at(cutter, z);
+                Disk {
+                    z,
+                    radius: cutter.radius_at(z),
+                    sin_kappa: sk,
+                    cos_kappa: ck,
+                    dz,
+                    db: dz / sk,
+                    entry: st,
+                    width: ex - st,
+                }
+            })
+            .collect();
+        let elements = disk_rows
+            .iter()
+            .flat_map(|d| {
+                (0..k).map(move |i| {
+                    let psi = cutter.tooth_angle(i, d.z);
+                    let (s, c) = psi.sin_cos();
+                    Element {
+                        psi,
+                        cos_psi: c,
+                        sin_psi: s,
+                    }
+                })
+            })
+            .collect();
+        EdgeTable {
+            teeth: k,
+            flat: disk_rows
+                .iter()
+                .all(|d| d.sin_kappa == 1.0 && d.cos_kappa == 0.0),
+            disks: disk_rows,
+            elements,
+        }
+    }
+
+    /// Number of teeth K.
+    pub fn teeth(&self) -> usize {
+        self.teeth
+    }
+    /// Number of disks.
+    pub fn len(&self) -> usize {
+        self.disks.len()
+    }
+    /// Always false (at least one disk).
+    pub fn is_empty(&self) -> bool {
+        self.disks.is_empty()
+    }
+    /// Disk j.
+    pub fn disk(&self, j: usize) -> &Disk {
+        &self.disks[j]
+    }
+    /// All disks, bottom up.
+    pub fn disks(&self) -> &[Disk] {
+        &self.disks
+    }
+    /// The K elements of disk j (tooth order).
+    pub fn elements(&self, j: usize) -> &[Element] {
+        &self.elements[j * self.teeth..(j + 1) * self.teeth]
+    }
+    /// True when κ = 90° on every disk (cylindrical kernel: the cheaper code path).
+    pub fn is_flat(&self) -> bool {
+        self.flat
+    }
+}
