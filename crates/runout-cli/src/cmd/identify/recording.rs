@@ -59,6 +59,18 @@ pub struct RecordingArgs {
     /// Helix angle (deg).
     #[arg(long)]
     pub helix_deg: Option<String>,
+    /// End profile: flat | ball | bull_nose | tapered (default flat).
+    #[arg(long, allow_hyphen_values = true)]
+    pub profile: Option<String>,
+    /// Corner radius r_c of a bull_nose cutter (mm), 0 < r_c <= D/2.
+    #[arg(long, allow_hyphen_values = true)]
+    pub corner_radius_mm: Option<String>,
+    /// Taper (half-cone) angle of a tapered cutter (deg), 0 < α < 45; D is the tip diameter.
+    #[arg(long, allow_hyphen_values = true)]
+    pub taper_deg: Option<String>,
+    /// Flute winding on a ball, bull-nose or taper: constant_lead | constant_helix (default constant_lead).
+    #[arg(long, allow_hyphen_values = true)]
+    pub flute_lead: Option<String>,
     /// Nominal spindle speed (rpm); the actual speed is measured from the signal.
     #[arg(long)]
     pub rpm: Option<String>,
@@ -127,7 +139,7 @@ pub struct RecordingArgs {
 
 impl RecordingArgs {
     fn layer(&self) -> Layer {
-        let pairs: [(&str, &Option<String>); 19] = [
+        let pairs: [(&str, &Option<String>); 23] = [
             ("chain", &self.chain),
             ("sensor_frf", &self.sensor_frf),
             ("sensor_mode_hz", &self.sensor_mode_hz),
@@ -135,6 +147,10 @@ impl RecordingArgs {
             ("teeth", &self.teeth),
             ("diameter_mm", &self.diameter_mm),
             ("helix_deg", &self.helix_deg),
+            ("profile", &self.profile),
+            ("corner_radius_mm", &self.corner_radius_mm),
+            ("taper_deg", &self.taper_deg),
+            ("flute_lead", &self.flute_lead),
             ("rpm", &self.rpm),
             ("fz_mm", &self.fz_mm),
             ("ap_mm", &self.ap_mm),
@@ -868,6 +884,7 @@ fn report_json(
         "conventions": "angles from tooth 0 in the direction of rotation; forces on the workpiece; tooth 0 is absolute only with a pulse channel and tooth0_angle_deg, otherwise the first tooth period of the average",
         "inputs": {
             "teeth": c.teeth(), "diameter_mm": c.diameter(), "helix_deg": c.helix().to_degrees(),
+            "profile": c.profile(), "flute_lead": c.lead(),
             "nominal_rpm": files.first().map(|f| f.cut.rpm()),
             "peak_component": case.peak_component, "fit_tilt": case.fit_tilt,
             "section_s": case.section_s,
@@ -901,6 +918,17 @@ fn pm(se: Option<f64>, scale: f64, digits: usize) -> String {
         .map_or_else(|| "(no SE)".into(), |s| format!("± {:.digits$}", s * scale))
 }
 
+/// The profile in the config vocabulary (`profile = …`, `corner_radius_mm`, `taper_deg`).
+fn profile_label(p: &runout_core::RadiusProfile) -> String {
+    use runout_core::RadiusProfile::*;
+    match p {
+        Flat => "flat".into(),
+        Ball => "ball".into(),
+        BullNose { corner_mm } => format!("bull_nose (corner radius {corner_mm} mm)"),
+        Tapered { taper_deg } => format!("tapered ({taper_deg}°)"),
+    }
+}
+
 fn print_text(
     case: &IdentifyCase,
     files: &[FileResult],
@@ -909,10 +937,11 @@ fn print_text(
     extra: &Extra,
 ) {
     println!(
-        "runout identify: K = {}, D = {} mm, helix {:.1}°",
+        "runout identify: K = {}, D = {} mm, helix {:.1}°, profile {}",
         case.cutter.teeth(),
         case.cutter.diameter(),
-        case.cutter.helix().to_degrees()
+        case.cutter.helix().to_degrees(),
+        profile_label(case.cutter.profile())
     );
     for f in files {
         let a = &f.analysis;
