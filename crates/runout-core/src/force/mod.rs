@@ -205,6 +205,13 @@ impl ForceModel {
         }
     }
 
+    /// Always the κ(z) kernel, also on a cylinder: for verification and benchmarks (on a flat
+    /// end mill it equals [`ForceModel::simulate`], which takes the cheaper path there).
+    pub fn simulate_general<C: ChipThickness>(&self, chip: &C, sampling: &Sampling) -> ForceSeries {
+        let table = EdgeTable::new(&self.cutter, &self.cut, sampling.disks);
+        self.simulate_table::<C, true>(chip, sampling, &table)
+    }
+
     /// The kernel; `GENERAL = false` only when κ = 90° on every disk (then sin κ = 1, cos κ = 0
     /// and db = dz, and the κ terms are left out of the inner loop).
     fn simulate_table<C: ChipThickness, const GENERAL: bool>(

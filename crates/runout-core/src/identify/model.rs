@@ -127,6 +127,12 @@ impl RevolutionModel {
         self.compute(e, tau, if tilt_derivs { 4 } else { 2 })
     }
 
+    /// [`RevolutionModel::sums`] through the κ(z) kernel also on a cylinder (verification and
+    /// benchmarks: on a flat end mill the results are the same).
+    pub fn sums_general(&self, e: [f64; 2], tau: [f64; 2], tilt_derivs: bool) -> BasisSums {
+        self.compute_kernel::<true>(e, tau, if tilt_derivs { 4 } else { 2 })
+    }
+
     /// Basis sums only (no derivatives): `deriv` is empty per sample.
     pub fn base_sums(&self, e: [f64; 2], tau: [f64; 2]) -> BasisSums {
         self.compute(e, tau, 0)

@@ -594,6 +594,15 @@ fn mean_force_calibration(
             fz_n: f.mean_force[2].is_finite().then_some(f.mean_force[2]),
         })
         .collect();
+    if !case.cutter.is_flat() {
+        // κ(z) and the per-disk window: the general design (400 disks: the integrals per disk
+        // are exact, the disks only sample R(z) and κ(z))
+        let design = runout_core::identify::MeanForceDesign::new(
+            &runout_core::edge::EdgeTable::new(&case.cutter, c0, 400),
+        );
+        return runout_core::identify::calibrate_mean_forces_general(&design, &data)
+            .map_err(|e| e.to_string());
+    }
     let (st, ex) = c0.immersion(&case.cutter);
     calibrate_mean_forces(case.cutter.teeth(), c0.ap(), st, ex, &data).map_err(|e| e.to_string())
 }
