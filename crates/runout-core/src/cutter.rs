@@ -298,6 +298,28 @@ impl Cutter {
         s.atan2(c)
     }
 
+    /// Arc length (mm) of the envelope's generator from the tip (z = 0) to height z: the edge
+    /// length per unit of flute lag, ∫₀^z dz′/sin κ(z′) (E&A's dS without the helical part):
+    /// ball R·κ(z) below the equator, bull nose r_c·κ(z) in the corner, tapered z/cos α,
+    /// cylinder z (continued above a ball or corner). The flat bottom of a bull nose or taper
+    /// (κ = 0, no height) is not part of it.
+    pub fn arc_length(&self, z: f64) -> f64 {
+        let z = z.max(0.0);
+        let corner = |rc: f64| {
+            if z >= rc {
+                rc * std::f64::consts::FRAC_PI_2 + (z - rc)
+            } else {
+                rc * self.lead_angle(z)
+            }
+        };
+        match self.profile {
+            RadiusProfile::Flat => z,
+            RadiusProfile::Ball => corner(self.radius),
+            RadiusProfile::BullNose { corner_mm } => corner(corner_mm),
+            RadiusProfile::Tapered { taper_deg } => z / taper_deg.to_radians().cos(),
+        }
+    }
+
     /// (sin κ, cos κ) at height z, see [`Cutter::lead_angle`]; exactly (1, 0) on a cylinder.
     pub fn lead_sin_cos(&self, z: f64) -> (f64, f64) {
         let r = self.radius;

@@ -164,6 +164,7 @@ struct DiskConst {
     width: f64,
     sin_kappa: f64,
     cos_kappa: f64,
+    dz: f64,
     db: f64,
 }
 
@@ -175,6 +176,9 @@ impl ForceModel {
     /// the normal chip is h·sin κ and (Lee & Altintas 1996; Engin & Altintas 2001)
     ///
     /// dF_t = (K_tc·h sin κ + K_te)·db,  dF_r = (K_rc·h sin κ + K_re)·db,  dF_a = (K_ac·h sin κ + K_ae)·db,
+    ///
+    /// with db = dz/sin κ, evaluated as K_c·h·dz + K_e·db (the shear part integrated exactly
+    /// over the disk, db the disk's exact edge length, [`crate::edge`]),
     ///
     /// projected on the workpiece frame through κ (the (r, a) pair rotated by κ in the plane of
     /// the axis and the tooth's radius; κ = 90° gives the cylindrical formulas of the module docs):
@@ -234,6 +238,7 @@ impl ForceModel {
                 width: d.width,
                 sin_kappa: d.sin_kappa,
                 cos_kappa: d.cos_kappa,
+                dz: d.dz,
                 db: d.db,
             })
             .collect();
@@ -269,6 +274,7 @@ impl ForceModel {
                     let mut f = [0.0f64; 4];
                     own.iter_mut().for_each(|v| *v = [0.0; 2]);
                     for (j, (ev, dc)) in evaluators.iter().zip(&consts).enumerate() {
+                        let dz = dc.dz;
                         let st = dc.entry;
                         let width = dc.width;
                         for (i, sl) in slices[j * k..(j + 1) * k].iter().enumerate() {
@@ -280,10 +286,12 @@ impl ForceModel {
                             // sin/cos of θ+ψ by the addition theorem: no trig in the inner loop.
                             let s = st_theta * sl.cos_psi + ct_theta * sl.sin_psi;
                             let co = ct_theta * sl.cos_psi - st_theta * sl.sin_psi;
-                            let mut h = ev.thickness(i, phi, s, co);
-                            if GENERAL {
-                                h *= dc.sin_kappa;
-                            }
+                            let h_arc = ev.thickness(i, phi, s, co);
+                            let h = if GENERAL {
+                                h_arc * dc.sin_kappa
+                            } else {
+                                h_arc
+                            };
                             if j == 0 {
                                 chip_out[q * k + i] = h;
                             }
@@ -291,17 +299,24 @@ impl ForceModel {
                                 continue;
                             }
                             max_chip[i] = max_chip[i].max(h);
-                            let db = dc.db;
-                            let ft = (kc.ktc * h + kc.kte) * db;
-                            let fr = (kc.krc * h + kc.kre) * db;
-                            let fa = (kc.kac * h + kc.kae) * db;
-                            let (frad, fax) = if GENERAL {
+                            let (ft, frad, fax) = if GENERAL {
+                                // K_c·(h sin κ)·db integrates to K_c·h_arc·dz (h_arc = h/sin κ)
+                                let hz = h_arc * dz;
+                                let db = dc.db;
+                                let ft = kc.ktc * hz + kc.kte * db;
+                                let fr = kc.krc * hz + kc.kre * db;
+                                let fa = kc.kac * hz + kc.kae * db;
                                 (
+                                    ft,
                                     fr * dc.sin_kappa - fa * dc.cos_kappa,
                                     fr * dc.cos_kappa + fa * dc.sin_kappa,
                                 )
                             } else {
-                                (fr, fa)
+                                (
+                                    (kc.ktc * h + kc.kte) * dz,
+                                    (kc.krc * h + kc.kre) * dz,
+                                    (kc.kac * h + kc.kae) * dz,
+                                )
                             };
                             let dx = ft * co + frad * s;
                             let dy = -ft * s + frad * co;
