@@ -34,6 +34,51 @@
 use crate::cut::Cut;
 use crate::cutter::Cutter;
 
+/// Fewest axial disks that resolve a non-cylindrical profile over the cut's axial depth: κ(z)
+/// changes by at most 0.25° and the immersion window (entry and exit angle) by at most 0.1° per
+/// disk, and R(z)
+/// by at most 0.1 % of R (1 on a cylinder, where nothing varies along z); at most 2000. The
+/// identification takes the larger of this and its helix-lag rule, so that its model resolves
+/// the ball's tip like the simulation. (The per-disk window switches the edge force on at a
+/// different angle on every disk: the discretisation error is first order in the disk count;
+/// measured on the ball below, 0.25° per disk left a 4 % bias in K_tc of a round trip whose
+/// truth had 2000 disks, 0.1° per disk 0.1 %.)
+///
+/// ```
+/// use runout_core::{edge::min_disks, Cut, Cutter, MillingMode, RadiusProfile};
+/// let ball = Cutter::new(6.0, vec![std::f64::consts::TAU / 3.0; 3], 30.0, 20.0, RadiusProfile::Ball).unwrap();
+/// let cut = Cut::new(10400.0, 0.05, 0.2).unwrap().radial(0.125, MillingMode::Down, &ball).unwrap();
+/// // κ(0.2 mm) = 21.0°, but the window sweeps from 180° (slot at the tip) to 27.9°: 1522 disks
+/// let n = min_disks(&ball, &cut);
+/// assert!(n > 1500 && n < 1540, "{n}");
+/// assert_eq!(min_disks(&Cutter::flat(6.0, 3, 30.0).unwrap(), &cut), 1);
+/// ```
+pub fn min_disks(cutter: &Cutter, cut: &Cut) -> usize {
+    let ap = cut.ap();
+    if cutter.is_flat() || !(ap > 0.0) {
+        return 1;
+    }
+    let dk = (cutter.lead_angle(ap) - cutter.lead_angle(0.0))
+        .abs()
+        .to_degrees();
+    let dr = (cutter.radius_at(ap) - cutter.radius_at(0.0)).abs() / cutter.radius();
+    // total variation of the entry and exit angles along z (sampled)
+    let m = 256;
+    let mut dw = 0.0f64;
+    let mut prev = cut.immersion_at(cutter, 0.0);
+    for q in 1..=m {
+        let w = cut.immersion_at(cutter, ap * q as f64 / m as f64);
+        dw += (w.0 - prev.0).abs().max((w.1 - prev.1).abs());
+        prev = w;
+    }
+    let n = (dk / 0.25).max(dw.to_degrees() / 0.1).max(dr / 1e-3).ceil();
+    if n.is_finite() {
+        (n as usize).clamp(1, 2000)
+    } else {
+        2000
+    }
+}
+
 /// Geometry of one axial disk.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Disk {
