@@ -79,8 +79,8 @@ fn recording(dir: &Path, name: &str, fz: f64, lambda_deg: f64, revs: f64, seed: 
     let path = dir.join(name);
     let mut f = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
     writeln!(f, "Fx,Fy,Fz").unwrap();
-    for k in 0..n {
-        writeln!(f, "{:.5},{:.5},{:.5}", chans[0][k], chans[1][k], chans[2][k]).unwrap();
+    for ((x, y), z) in chans[0].iter().zip(&chans[1]).zip(&chans[2]) {
+        writeln!(f, "{x:.5},{y:.5},{z:.5}").unwrap();
     }
     path
 }
@@ -246,11 +246,7 @@ fn profile_errors_name_the_parameter() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = dir.path().join("c.toml");
     std::fs::write(&cfg, "profile = \"ball\"\ntaper_deg = 3\n").unwrap();
-    let out = runout()
-        .args(base)
-        .arg(&cfg)
-        .output()
-        .unwrap();
+    let out = runout().args(base).arg(&cfg).output().unwrap();
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && e.contains("taper_deg"), "{e}");
 }
@@ -264,19 +260,50 @@ fn simulate_with_a_ball_profile() {
     let run = |profile: &str| -> serde_json::Value {
         let out = runout()
             .args([
-                "simulate", "--teeth", "3", "--diameter-mm", "6", "--helix-deg", "30", "--rpm",
-                "10400", "--fz-mm", "0.05", "--ap-mm", "0.2", "--ae-mm", "0.125", "--mode",
-                "down", "--ktc", "2000", "--krc", "800", "--disks", "50", "--profile", profile,
-                "--json", "-",
+                "simulate",
+                "--teeth",
+                "3",
+                "--diameter-mm",
+                "6",
+                "--helix-deg",
+                "30",
+                "--rpm",
+                "10400",
+                "--fz-mm",
+                "0.05",
+                "--ap-mm",
+                "0.2",
+                "--ae-mm",
+                "0.125",
+                "--mode",
+                "down",
+                "--ktc",
+                "2000",
+                "--krc",
+                "800",
+                "--disks",
+                "50",
+                "--profile",
+                profile,
+                "--json",
+                "-",
             ])
             .output()
             .unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         serde_json::from_slice(&out.stdout).unwrap()
     };
     let ball = run("ball");
     let flat = run("flat");
-    assert_eq!(ball["inputs"]["profile"]["kind"], "ball", "{}", ball["inputs"]);
+    assert_eq!(
+        ball["inputs"]["profile"]["kind"], "ball",
+        "{}",
+        ball["inputs"]
+    );
     let fz_ball = ball["mean_fz_N"].as_f64().unwrap();
     let fz_flat = flat["mean_fz_N"].as_f64().unwrap();
     assert_eq!(fz_flat, 0.0);

@@ -55,7 +55,7 @@ use crate::cutter::Cutter;
 /// ```
 pub fn min_disks(cutter: &Cutter, cut: &Cut) -> usize {
     let ap = cut.ap();
-    if cutter.is_flat() || !(ap > 0.0) {
+    if cutter.is_flat() || ap.is_nan() || ap <= 0.0 {
         return 1;
     }
     let dk = (cutter.lead_angle(ap) - cutter.lead_angle(0.0))

@@ -78,6 +78,7 @@ fn max_rel_diff(a: &ForceSeries, b: &ForceSeries) -> f64 {
 
 /// The cylindrical model as documented before issue 12 (`force` module docs), written out
 /// naively: disks at mid-heights, window from `Cut::immersion`, dF = (K_c h + K_e)·dz.
+#[allow(clippy::needless_range_loop)] // a literal transcription, indices as in the formulas
 fn naive_flat(m: &ForceModel, chip: &ArcChip, samp: &Sampling) -> [Vec<f64>; 3] {
     let k = m.cutter.teeth();
     let dz = m.cut.ap() / samp.disks as f64;
@@ -371,7 +372,10 @@ fn mean_force_calibration_of_a_ball() {
     ];
     for (g, w) in vals.iter().zip(want) {
         // 0.01° grid: the edge-force window edges cost O(step) ≈ 1e-4 of the edge terms
-        assert!((g - w).abs() < 2e-3 * w.abs().max(10.0), "{g} vs {w} ({vals:?})");
+        assert!(
+            (g - w).abs() < 2e-3 * w.abs().max(10.0),
+            "{g} vs {w} ({vals:?})"
+        );
     }
     // without F_z a ball cannot be calibrated: the error names F_z
     let no_z: Vec<MeanForces> = exact
@@ -525,7 +529,10 @@ fn ball_end_forces_match_an_independent_lee_altintas_implementation() {
             .collect();
         for (i, (r, p)) in s.own_peak_fxy.iter().zip(&peaks).enumerate() {
             let d = (r - p).abs() / p;
-            println!("a_p {ap} {mode_s}: tooth {i}: rust {r:.4} N, python {p:.4} N, {:.4} %", d * 100.0);
+            println!(
+                "a_p {ap} {mode_s}: tooth {i}: rust {r:.4} N, python {p:.4} N, {:.4} %",
+                d * 100.0
+            );
             worst = worst.max(d);
             assert!(d < 0.01, "tooth {i}: {r} vs {p}");
         }
@@ -577,12 +584,9 @@ fn ball_round_trip_on_a_synchronous_grid() {
             v.iter().map(|x| x + noise.sample(&mut rng)).collect()
         };
         let (fx, fy, fzz) = (noisy(&s.fx), noisy(&s.fy), noisy(&s.fz));
-        let waveform = AveragedWaveform::average(
-            0.0,
-            360,
-            &[(Axis::X, &fx), (Axis::Y, &fy), (Axis::Z, &fzz)],
-        )
-        .unwrap();
+        let waveform =
+            AveragedWaveform::average(0.0, 360, &[(Axis::X, &fx), (Axis::Y, &fy), (Axis::Z, &fzz)])
+                .unwrap();
         cases.push(WaveformCase {
             cutter: c.clone(),
             cut: m.cut,
@@ -597,7 +601,10 @@ fn ball_round_trip_on_a_synchronous_grid() {
         fit.coefficients, fit.coefficient_se, fit.r_squared, fit.disks
     );
     assert!((rho - 3.0).abs() <= 0.3, "ρ {rho}");
-    assert!(runout_core::angle::wrap_deg180(lam - 35.0).abs() <= 5.0, "λ {lam}");
+    assert!(
+        runout_core::angle::wrap_deg180(lam - 35.0).abs() <= 5.0,
+        "λ {lam}"
+    );
     for ((g, t), se) in fit
         .coefficients
         .iter()

@@ -247,12 +247,16 @@ impl ForceModel {
             .iter()
             .enumerate()
             .flat_map(|(j, d)| {
-                table.elements(j).iter().enumerate().map(move |(i, el)| Slice {
-                    cos_psi: el.cos_psi,
-                    sin_psi: el.sin_psi,
-                    psi: el.psi,
-                    radius: self.runout.tooth_radius(&self.cutter, i, d.z),
-                })
+                table
+                    .elements(j)
+                    .iter()
+                    .enumerate()
+                    .map(move |(i, el)| Slice {
+                        cos_psi: el.cos_psi,
+                        sin_psi: el.sin_psi,
+                        psi: el.psi,
+                        radius: self.runout.tooth_radius(&self.cutter, i, d.z),
+                    })
             })
             .collect();
         let kc = self.coefficients;
@@ -287,11 +291,7 @@ impl ForceModel {
                             let s = st_theta * sl.cos_psi + ct_theta * sl.sin_psi;
                             let co = ct_theta * sl.cos_psi - st_theta * sl.sin_psi;
                             let h_arc = ev.thickness(i, phi, s, co);
-                            let h = if GENERAL {
-                                h_arc * dc.sin_kappa
-                            } else {
-                                h_arc
-                            };
+                            let h = if GENERAL { h_arc * dc.sin_kappa } else { h_arc };
                             if j == 0 {
                                 chip_out[q * k + i] = h;
                             }

@@ -272,8 +272,16 @@ impl MeanForceDesign {
 
     /// True when K_ac and K_ae do not enter F̄_x and F̄_y (κ = 90° everywhere).
     pub fn is_planar(&self) -> bool {
-        let scale = self.shear.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-        let escale = self.edge.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        let scale = self
+            .shear
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let escale = self
+            .edge
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
         (0..2).all(|i| {
             self.shear[i][2].abs() <= 1e-12 * scale && self.edge[i][2].abs() <= 1e-12 * escale
         })
@@ -325,7 +333,9 @@ pub fn calibrate_mean_forces_general(
     let solve = |m: &[[f64; 3]; 3], rows: usize, v: &[f64], sv: &[f64]| {
         let n = rows;
         let mat = nalgebra::DMatrix::from_fn(n, n, |i, j| m[i][j]);
-        let inv = mat.try_inverse().filter(|inv| inv.iter().all(|x| x.is_finite()));
+        let inv = mat
+            .try_inverse()
+            .filter(|inv| inv.iter().all(|x| x.is_finite()));
         inv.map(|inv| {
             (0..n)
                 .map(|i| Estimate {

@@ -254,7 +254,10 @@ pub fn read_cases(path: &Path) -> Result<Vec<ChipCase>, ChipConfigError> {
 
 fn cutter_of(s: &ChipCaseSpec) -> Result<Cutter, String> {
     if s.corner_mm.is_some() && s.corner_radius_mm.is_some() {
-        return Err("corner_radius_mm: give either corner_radius_mm or its older name corner_mm, not both".into());
+        return Err(
+            "corner_radius_mm: give either corner_radius_mm or its older name corner_mm, not both"
+                .into(),
+        );
     }
     let profile: RadiusProfile = super::radius_profile(
         &s.profile,

@@ -395,7 +395,9 @@ pub fn radius_profile(
         if name != "tapered" {
             return err(
                 "taper_deg",
-                format!("a taper angle is only for profile = tapered, got {t}° with profile = {name}"),
+                format!(
+                    "a taper angle is only for profile = tapered, got {t}° with profile = {name}"
+                ),
             );
         }
     }

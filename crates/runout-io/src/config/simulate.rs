@@ -5,8 +5,7 @@ use super::{ConfigError, Settings};
 use crate::units::Quantity;
 use runout_core::{
     limits, Cut, Cutter, CuttingCoefficients, FluteLead, MillingMode, ParamError, RadiusProfile,
-    Runout,
-    Sampling,
+    Runout, Sampling,
 };
 
 /// Every key of a simulation case: (key, quantity, help). The CLI flag is `--key-with-dashes`.
