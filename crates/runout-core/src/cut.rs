@@ -194,4 +194,27 @@ impl Cut {
             }
         }
     }
+
+    /// Entry and exit immersion angles (rad) of the disk at height `z` above the tip, with a_e
+    /// measured from the wall at that height ([`crate::edge`]): the wall of the previous pass is
+    /// at R(z) − a_e, so the window is arccos(1 − a_e/R(z)) wide (clamped: a full slot [0, π]
+    /// where a_e ≥ 2R(z)). Equals [`Cut::immersion`] on a cylinder.
+    pub fn immersion_at(&self, cutter: &Cutter, z: f64) -> (f64, f64) {
+        match self.engagement {
+            Engagement::Angles { entry, exit } => (entry, exit),
+            Engagement::Radial { ae, mode } => {
+                let r = cutter.radius_at(z);
+                let a = if r > 0.0 {
+                    (1.0 - ae / r).clamp(-1.0, 1.0).acos()
+                } else {
+                    PI
+                };
+                match mode {
+                    MillingMode::Up => (0.0, a),
+                    MillingMode::Down => (PI - a, PI),
+                    MillingMode::Slot => (0.0, PI),
+                }
+            }
+        }
+    }
 }

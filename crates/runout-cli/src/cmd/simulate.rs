@@ -32,6 +32,18 @@ pub struct CaseFlags {
     /// Flute length (mm).
     #[arg(long, allow_hyphen_values = true)]
     pub flute_length_mm: Option<String>,
+    /// End profile: flat | ball | bull_nose | tapered (default flat).
+    #[arg(long, allow_hyphen_values = true)]
+    pub profile: Option<String>,
+    /// Corner radius r_c of a bull_nose cutter (mm), 0 < r_c <= D/2.
+    #[arg(long, allow_hyphen_values = true)]
+    pub corner_radius_mm: Option<String>,
+    /// Taper (half-cone) angle of a tapered cutter (deg), 0 < α < 45; D is the tip diameter.
+    #[arg(long, allow_hyphen_values = true)]
+    pub taper_deg: Option<String>,
+    /// Flute winding on a ball, bull-nose or taper: constant_lead | constant_helix (default constant_lead).
+    #[arg(long, allow_hyphen_values = true)]
+    pub flute_lead: Option<String>,
     /// Spindle speed (rpm).
     #[arg(long, allow_hyphen_values = true)]
     pub rpm: Option<String>,
@@ -156,6 +168,10 @@ impl CaseFlags {
             ("helix_deg", &c.helix_deg),
             ("pitch_deg", &c.pitch_deg),
             ("flute_length_mm", &c.flute_length_mm),
+            ("profile", &c.profile),
+            ("corner_radius_mm", &c.corner_radius_mm),
+            ("taper_deg", &c.taper_deg),
+            ("flute_lead", &c.flute_lead),
             ("rpm", &c.rpm),
             ("fz_mm", &c.fz_mm),
             ("ap_mm", &c.ap_mm),
@@ -441,6 +457,8 @@ pub fn summary_json(
             "teeth": c.teeth(),
             "diameter_mm": c.diameter(),
             "helix_deg": c.helix().to_degrees(),
+            "profile": c.profile(),
+            "flute_lead": c.lead(),
             "pitch_deg": c.pitch().iter().map(|p| p.to_degrees()).collect::<Vec<_>>(),
             "rpm": cut.rpm(),
             "fz_mm": cut.fz(),

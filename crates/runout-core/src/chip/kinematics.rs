@@ -745,6 +745,7 @@ pub fn radius_slope(cutter: &Cutter, z: f64) -> f64 {
         RadiusProfile::Flat => 0.0,
         RadiusProfile::Ball => corner(r),
         RadiusProfile::BullNose { corner_mm } => corner(*corner_mm),
+        RadiusProfile::Tapered { taper_deg } => taper_deg.to_radians().tan(),
     }
 }
 

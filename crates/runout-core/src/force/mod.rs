@@ -22,6 +22,7 @@ use crate::chip::{ChipAtHeight, ChipThickness};
 use crate::coefficients::CuttingCoefficients;
 use crate::cut::Cut;
 use crate::cutter::Cutter;
+use crate::edge::EdgeTable;
 use crate::error::{positive, ParamError};
 use crate::runout::Runout;
 use rayon::prelude::*;
@@ -148,7 +149,7 @@ impl ForceSeries {
     }
 }
 
-/// Per (disk, tooth) precomputed geometry.
+/// Per (disk, tooth) runout-dependent radius next to the shared [`EdgeTable`] geometry.
 struct Slice {
     cos_psi: f64,
     sin_psi: f64,
@@ -156,8 +157,37 @@ struct Slice {
     radius: f64,
 }
 
+/// Per-disk constants of the kernel.
+#[derive(Clone, Copy)]
+struct DiskConst {
+    entry: f64,
+    width: f64,
+    sin_kappa: f64,
+    cos_kappa: f64,
+    dz: f64,
+    db: f64,
+}
+
 impl ForceModel {
     /// Simulate the forces with chip model `chip` over `sampling`.
+    ///
+    /// Per disk the table [`EdgeTable`] gives R(z), κ(z), db = dz/sin κ and the immersion window
+    /// (module docs of [`crate::edge`]). With h the chip thickness of `chip` in the radial plane,
+    /// the normal chip is h·sin κ and (Lee & Altintas 1996; Engin & Altintas 2001)
+    ///
+    /// dF_t = (K_tc·h sin κ + K_te)·db,  dF_r = (K_rc·h sin κ + K_re)·db,  dF_a = (K_ac·h sin κ + K_ae)·db,
+    ///
+    /// with db = dz/sin κ, evaluated as K_c·h·dz + K_e·db (the shear part integrated exactly
+    /// over the disk, db the disk's exact edge length, [`crate::edge`]),
+    ///
+    /// projected on the workpiece frame through κ (the (r, a) pair rotated by κ in the plane of
+    /// the axis and the tooth's radius; κ = 90° gives the cylindrical formulas of the module docs):
+    ///
+    /// F_x = Σ [dF_t cos φ + (dF_r sin κ − dF_a cos κ) sin φ],
+    /// F_y = Σ [−dF_t sin φ + (dF_r sin κ − dF_a cos κ) cos φ],
+    /// F_z = −Σ (dF_r cos κ + dF_a sin κ).
+    ///
+    /// `ForceSeries::chip` and `max_chip` are the normal chip h·sin κ.
     ///
     /// ```
     /// use runout_core::*;
@@ -171,28 +201,62 @@ impl ForceModel {
     /// assert!((peak - 247.361).abs() < 0.02);
     /// ```
     pub fn simulate<C: ChipThickness>(&self, chip: &C, sampling: &Sampling) -> ForceSeries {
+        let table = EdgeTable::new(&self.cutter, &self.cut, sampling.disks);
+        if table.is_flat() {
+            self.simulate_table::<C, false>(chip, sampling, &table)
+        } else {
+            self.simulate_table::<C, true>(chip, sampling, &table)
+        }
+    }
+
+    /// Always the κ(z) kernel, also on a cylinder: for verification and benchmarks (on a flat
+    /// end mill it equals [`ForceModel::simulate`], which takes the cheaper path there).
+    pub fn simulate_general<C: ChipThickness>(&self, chip: &C, sampling: &Sampling) -> ForceSeries {
+        let table = EdgeTable::new(&self.cutter, &self.cut, sampling.disks);
+        self.simulate_table::<C, true>(chip, sampling, &table)
+    }
+
+    /// The kernel; `GENERAL = false` only when κ = 90° on every disk (then sin κ = 1, cos κ = 0
+    /// and db = dz, and the κ terms are left out of the inner loop).
+    fn simulate_table<C: ChipThickness, const GENERAL: bool>(
+        &self,
+        chip: &C,
+        sampling: &Sampling,
+        table: &EdgeTable,
+    ) -> ForceSeries {
         let k = self.cutter.teeth();
         let n = sampling.samples();
-        let dz = self.cut.ap() / sampling.disks as f64;
-        let (st, ex) = self.cut.immersion(&self.cutter);
-        let width = ex - st;
         let omega = self.cut.omega();
 
-        let heights: Vec<f64> = (0..sampling.disks).map(|j| (j as f64 + 0.5) * dz).collect();
-        let evaluators: Vec<C::AtHeight> = heights.iter().map(|&z| chip.at_height(z)).collect();
-        let slices: Vec<Slice> = heights
+        let evaluators: Vec<C::AtHeight> =
+            table.disks().iter().map(|d| chip.at_height(d.z)).collect();
+        let consts: Vec<DiskConst> = table
+            .disks()
             .iter()
-            .flat_map(|&z| {
-                (0..k).map(move |i| {
-                    let psi = self.cutter.tooth_angle(i, z);
-                    let (s, c) = psi.sin_cos();
-                    Slice {
-                        cos_psi: c,
-                        sin_psi: s,
-                        psi,
-                        radius: self.runout.tooth_radius(&self.cutter, i, z),
-                    }
-                })
+            .map(|d| DiskConst {
+                entry: d.entry,
+                width: d.width,
+                sin_kappa: d.sin_kappa,
+                cos_kappa: d.cos_kappa,
+                dz: d.dz,
+                db: d.db,
+            })
+            .collect();
+        let slices: Vec<Slice> = table
+            .disks()
+            .iter()
+            .enumerate()
+            .flat_map(|(j, d)| {
+                table
+                    .elements(j)
+                    .iter()
+                    .enumerate()
+                    .map(move |(i, el)| Slice {
+                        cos_psi: el.cos_psi,
+                        sin_psi: el.sin_psi,
+                        psi: el.psi,
+                        radius: self.runout.tooth_radius(&self.cutter, i, d.z),
+                    })
             })
             .collect();
         let kc = self.coefficients;
@@ -213,7 +277,10 @@ impl ForceModel {
                     let (st_theta, ct_theta) = theta.sin_cos();
                     let mut f = [0.0f64; 4];
                     own.iter_mut().for_each(|v| *v = [0.0; 2]);
-                    for (j, ev) in evaluators.iter().enumerate() {
+                    for (j, (ev, dc)) in evaluators.iter().zip(&consts).enumerate() {
+                        let dz = dc.dz;
+                        let st = dc.entry;
+                        let width = dc.width;
                         for (i, sl) in slices[j * k..(j + 1) * k].iter().enumerate() {
                             let rel = wrap_tau(theta + sl.psi - st);
                             if rel > width {
@@ -223,7 +290,8 @@ impl ForceModel {
                             // sin/cos of θ+ψ by the addition theorem: no trig in the inner loop.
                             let s = st_theta * sl.cos_psi + ct_theta * sl.sin_psi;
                             let co = ct_theta * sl.cos_psi - st_theta * sl.sin_psi;
-                            let h = ev.thickness(i, phi, s, co);
+                            let h_arc = ev.thickness(i, phi, s, co);
+                            let h = if GENERAL { h_arc * dc.sin_kappa } else { h_arc };
                             if j == 0 {
                                 chip_out[q * k + i] = h;
                             }
@@ -231,14 +299,30 @@ impl ForceModel {
                                 continue;
                             }
                             max_chip[i] = max_chip[i].max(h);
-                            let ft = (kc.ktc * h + kc.kte) * dz;
-                            let fr = (kc.krc * h + kc.kre) * dz;
-                            let fa = (kc.kac * h + kc.kae) * dz;
-                            let dx = ft * co + fr * s;
-                            let dy = -ft * s + fr * co;
+                            let (ft, frad, fax) = if GENERAL {
+                                // K_c·(h sin κ)·db integrates to K_c·h_arc·dz (h_arc = h/sin κ)
+                                let hz = h_arc * dz;
+                                let db = dc.db;
+                                let ft = kc.ktc * hz + kc.kte * db;
+                                let fr = kc.krc * hz + kc.kre * db;
+                                let fa = kc.kac * hz + kc.kae * db;
+                                (
+                                    ft,
+                                    fr * dc.sin_kappa - fa * dc.cos_kappa,
+                                    fr * dc.cos_kappa + fa * dc.sin_kappa,
+                                )
+                            } else {
+                                (
+                                    (kc.ktc * h + kc.kte) * dz,
+                                    (kc.krc * h + kc.kre) * dz,
+                                    (kc.kac * h + kc.kae) * dz,
+                                )
+                            };
+                            let dx = ft * co + frad * s;
+                            let dy = -ft * s + frad * co;
                             f[0] += dx;
                             f[1] += dy;
-                            f[2] -= fa;
+                            f[2] -= fax;
                             f[3] += ft * sl.radius;
                             own[i][0] += dx;
                             own[i][1] += dy;

@@ -13,18 +13,20 @@
 //!    residual after a linear least-squares solve is a cheap function of θ₀; a grid over ±w and a
 //!    parabola through the best three points give θ₀ to a small fraction of a degree.
 
-use super::model::{force_from_basis, RevolutionModel};
+use super::model::{coefficient_gradient, force_from_basis, RevolutionModel};
 use super::waveform::{Axis, WaveformCase};
 use crate::angle::wrap_pi;
 use crate::coefficients::CuttingCoefficients;
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::TAU;
 
-/// Axial disks for alignment evaluations: 0.1° of helix lag per disk (as the full-signal fit's
-/// automatic choice), at most 2000.
+/// Axial disks for alignment evaluations: 0.1° of helix lag per disk and at least
+/// [`crate::edge::min_disks`] (as the full-signal fit's automatic choice), at most 2000.
 fn disks(case: &WaveformCase) -> usize {
     let lag = case.cut.ap() * case.cutter.tan_helix().abs() / case.cutter.radius();
-    ((lag / 0.1f64.to_radians()).ceil() as usize).clamp(1, 2000)
+    ((lag / 0.1f64.to_radians()).ceil() as usize)
+        .max(crate::edge::min_disks(&case.cutter, &case.cut))
+        .clamp(1, 2000)
 }
 
 /// Model forces per axis on the waveform's grid starting at `start` (rad).
@@ -116,27 +118,17 @@ pub fn residual_at(case: &WaveformCase, start: f64, e: [f64; 2], tau: [f64; 2]) 
     let b = RevolutionModel::new(&case.cutter, &case.cut, start, n, disks(case))
         .base_sums(e, tau)
         .base;
-    let mut rows_xy: Vec<[f64; 4]> = Vec::new();
-    let mut y_xy: Vec<f64> = Vec::new();
-    let mut rows_z: Vec<[f64; 2]> = Vec::new();
-    let mut y_z: Vec<f64> = Vec::new();
+    // one design row per sample: ∂F/∂(K_tc, K_rc, K_ac, K_te, K_re, K_ae) from the shared basis
+    // (`model` module docs; on a cylinder the x–y and z blocks decouple)
+    let mut rows: Vec<[f64; 6]> = Vec::new();
+    let mut y: Vec<f64> = Vec::new();
     for c in &case.waveform.components {
         for (q, v) in c.values.iter().enumerate() {
-            let s = &b[q];
-            match c.axis {
-                // F_x = K_tc b0 + K_rc b1 + K_te b2 + K_re b3; F_y = −K_tc b1 + K_rc b0 − K_te b3 + K_re b2
-                Axis::X => rows_xy.push([s[0], s[1], s[2], s[3]]),
-                Axis::Y => rows_xy.push([-s[1], s[0], -s[3], s[2]]),
-                Axis::Z => {
-                    rows_z.push([-s[4], -s[5]]);
-                    y_z.push(*v);
-                    continue;
-                }
-            }
-            y_xy.push(*v);
+            rows.push(coefficient_gradient(c.axis, &b[q]));
+            y.push(*v);
         }
     }
-    lsq_rss(&rows_xy, &y_xy) + lsq_rss(&rows_z, &y_z)
+    lsq_rss(&rows, &y)
 }
 
 fn lsq_rss<const P: usize>(rows: &[[f64; P]], y: &[f64]) -> f64 {

@@ -182,7 +182,8 @@ fn fitted_coefficients(cases: &[WaveformCase]) -> Vec<usize> {
     }
 }
 
-/// Automatic disk count: helix lag a_p·tanβ/R per disk ≤ 0.1°.
+/// Automatic disk count: helix lag a_p·tanβ/R per disk ≤ 0.1°, and at least
+/// [`crate::edge::min_disks`] for a ball, bull-nose or tapered cutter.
 fn auto_disks(cases: &[WaveformCase], tilt: bool) -> usize {
     let lag = cases
         .iter()
@@ -192,7 +193,12 @@ fn auto_disks(cases: &[WaveformCase], tilt: bool) -> usize {
                 .to_degrees()
         })
         .fold(0.0, f64::max);
-    let d = (lag / 0.1).ceil().max(1.0) as usize;
+    let profile = cases
+        .iter()
+        .map(|c| crate::edge::min_disks(&c.cutter, &c.cut))
+        .max()
+        .unwrap_or(1);
+    let d = ((lag / 0.1).ceil().max(1.0) as usize).max(profile);
     if tilt { d.max(8) } else { d }.min(2000)
 }
 

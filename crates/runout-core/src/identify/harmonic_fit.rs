@@ -32,7 +32,7 @@ use super::full_signal::{
     FullSignalOptions, RunoutObservability, NAMES, RUNOUT_STEP_UM,
 };
 use super::lsq::linear_lsq;
-use super::model::{coefficient_gradient, BasisSums, RevolutionModel};
+use super::model::{coefficient_gradient, BasisSums, RevolutionModel, NB};
 use super::sine_fit::Estimate;
 use super::waveform::{Axis, WaveformCase};
 use crate::chain::{AxisChain, Complex64, MeasuringChain, SensorMode};
@@ -340,18 +340,29 @@ impl HarmonicProblem<'_> {
             })
             .collect();
     }
-    /// Harmonics 0..=L·N/2 of the six basis sums on the oversampled grid, scaled by 1/L so that
-    /// they compare with an N-point DFT.
+    /// Harmonics 0..=L·N/2 of the [`NB`] basis sums on the oversampled grid, scaled by 1/L so
+    /// that they compare with an N-point DFT. On a cylinder only rows 0–5 are transformed (rows
+    /// 6–9 repeat rows 0–3, rows 10–15 are zero: `model` module docs).
     fn basis_harmonics(&self, c: usize, s: &BasisSums) -> Vec<Vec<Complex64>> {
         let fft = &self.planner_cache[c];
-        (0..6)
-            .map(|r| {
-                let mut buf: Vec<f64> = s.base.iter().map(|b| b[r]).collect();
-                let mut out = fft.make_output_vec();
-                fft.process(&mut buf, &mut out).expect("fft length");
-                out.iter().map(|v| v / self.oversample as f64).collect()
-            })
-            .collect()
+        let flat = self.models[c].is_flat();
+        let transform = |r: usize| -> Vec<Complex64> {
+            let mut buf: Vec<f64> = s.base.iter().map(|b| b[r]).collect();
+            let mut out = fft.make_output_vec();
+            fft.process(&mut buf, &mut out).expect("fft length");
+            out.iter().map(|v| v / self.oversample as f64).collect()
+        };
+        if flat {
+            let mut rows: Vec<Vec<Complex64>> = (0..6).map(transform).collect();
+            let zero = vec![Complex64::new(0.0, 0.0); rows[0].len()];
+            for r in 0..4 {
+                rows.push(rows[r].clone());
+            }
+            rows.resize(NB, zero);
+            rows
+        } else {
+            (0..NB).map(transform).collect()
+        }
     }
     /// What N-point sampling makes of a real signal with harmonics Y_m (m = 0..=L·N/2) at
     /// harmonic k, times the resampling attenuation S_k:
@@ -423,9 +434,9 @@ impl HarmonicProblem<'_> {
     /// Rigid-model harmonic of the coefficient-gradient column i (K order) for axis.
     fn gradient_harmonic(&self, c: usize, axis: Axis, k: usize) -> [Complex64; 6] {
         let b = &self.basis[c];
-        let mut re = [0.0; 6];
-        let mut im = [0.0; 6];
-        for r in 0..6 {
+        let mut re = [0.0; NB];
+        let mut im = [0.0; NB];
+        for r in 0..NB {
             re[r] = b[r][k].re;
             im[r] = b[r][k].im;
         }

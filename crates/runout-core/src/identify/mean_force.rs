@@ -29,6 +29,8 @@
 use super::error::IdentifyError;
 use super::lsq::{fit_line, Regression};
 use super::sine_fit::Estimate;
+use crate::coefficients::CuttingCoefficients;
+use crate::edge::EdgeTable;
 use crate::error::{finite, positive, ParamError};
 use serde::Serialize;
 
@@ -194,6 +196,196 @@ pub fn calibrate_mean_forces(
         kte: comb(ic, -is, &fit_x, &fit_y, false, de),
         kre: comb(is, ic, &fit_x, &fit_y, false, de),
         kae,
+        fit_x,
+        fit_y,
+        fit_z,
+    })
+}
+
+/// Mean-force design of a general end mill (ball, bull nose, taper; issue 12): the revolution
+/// means are F̄ = f_z·A·[K_tc, K_rc, K_ac]ᵀ + B·[K_te, K_re, K_ae]ᵀ (rows x, y, z), summed over the
+/// disks of an [`EdgeTable`] with each disk's own window [φ_st(z), φ_ex(z)] and lead angle κ(z).
+///
+/// Averaging the force model of [`crate::ForceModel::simulate`] (h = f_z sin φ, normal chip
+/// h sin κ, chip width db = dz/sin κ) over one revolution, with c = K/(2π) and the immersion
+/// integrals I_sc, I_ss, I_c, I_s, W of [`immersion_integrals`] over the disk's window:
+///
+/// | | K_tc | K_rc | K_ac |
+/// |---|---|---|---|
+/// | A_x | c Σ I_sc dz | c Σ sin κ I_ss dz | −c Σ cos κ I_ss dz |
+/// | A_y | −c Σ I_ss dz | c Σ sin κ I_sc dz | −c Σ cos κ I_sc dz |
+/// | A_z | 0 | −c Σ cos κ I_s dz | −c Σ sin κ I_s dz |
+///
+/// and B the same with I_sc → I_c, I_ss → I_s, I_s → W (the z row) and dz → db. On a cylinder
+/// (κ = 90°) this is exactly the flat formula of the module docs (A_x = c·a·[I_sc, I_ss, 0], …).
+/// Unlike the flat cutter, K_ac enters F̄_x and F̄_y through cos κ: the x–y–z system is solved
+/// jointly, so F_z is needed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeanForceDesign {
+    /// A (per unit f_z): rows x, y, z; columns K_tc, K_rc, K_ac.
+    pub shear: [[f64; 3]; 3],
+    /// B: rows x, y, z; columns K_te, K_re, K_ae.
+    pub edge: [[f64; 3]; 3],
+}
+
+impl MeanForceDesign {
+    /// The design of `table` (see the type docs).
+    pub fn new(table: &EdgeTable) -> Self {
+        let c = table.teeth() as f64 / std::f64::consts::TAU;
+        let mut a = [[0.0; 3]; 3];
+        let mut b = [[0.0; 3]; 3];
+        for d in table.disks() {
+            if d.width.is_nan() || d.width <= 0.0 {
+                continue;
+            }
+            let [isc, iss, ic, is, w] = immersion_integrals(d.entry, d.entry + d.width);
+            let (sk, ck) = (d.sin_kappa, d.cos_kappa);
+            let rows = |p: f64, q: f64, r: f64, l: f64| {
+                [
+                    [c * p * l, c * sk * q * l, -c * ck * q * l],
+                    [-c * q * l, c * sk * p * l, -c * ck * p * l],
+                    [0.0, -c * ck * r * l, -c * sk * r * l],
+                ]
+            };
+            let sa = rows(isc, iss, is, d.dz);
+            let sb = rows(ic, is, w, d.db);
+            for i in 0..3 {
+                for j in 0..3 {
+                    a[i][j] += sa[i][j];
+                    b[i][j] += sb[i][j];
+                }
+            }
+        }
+        MeanForceDesign { shear: a, edge: b }
+    }
+
+    /// Predicted mean forces [F̄_x, F̄_y, F̄_z] (N) at feed `fz_mm` with coefficients `kc`.
+    pub fn predict(&self, fz_mm: f64, kc: &CuttingCoefficients) -> [f64; 3] {
+        let s = [kc.ktc, kc.krc, kc.kac];
+        let e = [kc.kte, kc.kre, kc.kae];
+        std::array::from_fn(|i| {
+            (0..3)
+                .map(|j| fz_mm * self.shear[i][j] * s[j] + self.edge[i][j] * e[j])
+                .sum()
+        })
+    }
+
+    /// True when K_ac and K_ae do not enter F̄_x and F̄_y (κ = 90° everywhere).
+    pub fn is_planar(&self) -> bool {
+        let scale = self
+            .shear
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let escale = self
+            .edge
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        (0..2).all(|i| {
+            self.shear[i][2].abs() <= 1e-12 * scale && self.edge[i][2].abs() <= 1e-12 * escale
+        })
+    }
+}
+
+/// Calibrate the six coefficients of a general end mill from mean forces at ≥ 2 distinct feeds:
+/// each component is regressed on f_z (slope s, intercept e, as [`calibrate_mean_forces`]) and
+/// [K_tc, K_rc, K_ac] = A⁻¹·s, [K_te, K_re, K_ae] = B⁻¹·e with the design of
+/// [`MeanForceDesign`]; standard errors propagate linearly (σ_K,i² = Σ_j (A⁻¹)_ij² σ_s,j², the three
+/// regressions being independent). Without F_z only a planar design (κ = 90°) can be solved
+/// (the 2×2 x–y systems of the flat formula); otherwise the error names F_z.
+pub fn calibrate_mean_forces_general(
+    design: &MeanForceDesign,
+    data: &[MeanForces],
+) -> Result<MeanForceCalibration, IdentifyError> {
+    for (i, d) in data.iter().enumerate() {
+        positive(&format!("fz_mm[{i}]"), d.fz_mm)?;
+        finite(&format!("fx_N[{i}]"), d.fx_n)?;
+        finite(&format!("fy_N[{i}]"), d.fy_n)?;
+        if let Some(z) = d.fz_n {
+            finite(&format!("fz_N[{i}]"), z)?;
+        }
+    }
+    let mut feeds: Vec<f64> = data.iter().map(|d| d.fz_mm).collect();
+    feeds.sort_by(f64::total_cmp);
+    feeds.dedup();
+    if feeds.len() < 2 {
+        return Err(IdentifyError::too_few(
+            "mean-force calibration",
+            "at least 2 distinct feeds",
+            format!("{} distinct feed(s)", feeds.len()),
+        ));
+    }
+    let f: Vec<f64> = data.iter().map(|d| d.fz_mm).collect();
+    let fx: Vec<f64> = data.iter().map(|d| d.fx_n).collect();
+    let fy: Vec<f64> = data.iter().map(|d| d.fy_n).collect();
+    let fit_x = fit_line(&f, &fx, true)?;
+    let fit_y = fit_line(&f, &fy, true)?;
+    let has_z = data.iter().all(|d| d.fz_n.is_some());
+    let fit_z = if has_z {
+        let fz: Vec<f64> = data.iter().map(|d| d.fz_n.unwrap_or(0.0)).collect();
+        Some(fit_line(&f, &fz, true)?)
+    } else {
+        None
+    };
+    let se = |v: f64| v.is_finite().then_some(v);
+    // solve M·k = v for the rows used, with standard errors
+    let solve = |m: &[[f64; 3]; 3], rows: usize, v: &[f64], sv: &[f64]| {
+        let n = rows;
+        let mat = nalgebra::DMatrix::from_fn(n, n, |i, j| m[i][j]);
+        let inv = mat
+            .try_inverse()
+            .filter(|inv| inv.iter().all(|x| x.is_finite()));
+        inv.map(|inv| {
+            (0..n)
+                .map(|i| Estimate {
+                    value: (0..n).map(|j| inv[(i, j)] * v[j]).sum(),
+                    se: se((0..n)
+                        .map(|j| (inv[(i, j)] * sv[j]).powi(2))
+                        .sum::<f64>()
+                        .sqrt()),
+                })
+                .collect::<Vec<_>>()
+        })
+    };
+    let singular = || IdentifyError::singular("mean-force calibration", "engagement too small");
+    let (shear, edge) = match &fit_z {
+        Some(z) => {
+            let s = [fit_x.slope, fit_y.slope, z.slope];
+            let ss = [fit_x.slope_se, fit_y.slope_se, z.slope_se];
+            let e = [fit_x.intercept, fit_y.intercept, z.intercept];
+            let es = [fit_x.intercept_se, fit_y.intercept_se, z.intercept_se];
+            (
+                solve(&design.shear, 3, &s, &ss).ok_or_else(singular)?,
+                solve(&design.edge, 3, &e, &es).ok_or_else(singular)?,
+            )
+        }
+        None => {
+            if !design.is_planar() {
+                return Err(IdentifyError::too_few(
+                    "mean-force calibration",
+                    "F_z in every recording (on a ball, bull-nose or tapered cutter K_ac enters \
+                     F_x and F_y through the lead angle κ)",
+                    "F_z missing",
+                ));
+            }
+            let s = [fit_x.slope, fit_y.slope];
+            let ss = [fit_x.slope_se, fit_y.slope_se];
+            let e = [fit_x.intercept, fit_y.intercept];
+            let es = [fit_x.intercept_se, fit_y.intercept_se];
+            (
+                solve(&design.shear, 2, &s, &ss).ok_or_else(singular)?,
+                solve(&design.edge, 2, &e, &es).ok_or_else(singular)?,
+            )
+        }
+    };
+    Ok(MeanForceCalibration {
+        ktc: shear[0],
+        krc: shear[1],
+        kac: shear.get(2).copied(),
+        kte: edge[0],
+        kre: edge[1],
+        kae: edge.get(2).copied(),
         fit_x,
         fit_y,
         fit_z,

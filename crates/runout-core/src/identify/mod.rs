@@ -57,10 +57,11 @@ pub use full_signal::{
 pub use harmonic_fit::{ChainFitReport, ChainModel, ChainOptions, FittedMode};
 pub use lsq::{fit_line, linear_lsq, r_squared, LinearFit, Regression};
 pub use mean_force::{
-    calibrate_mean_forces, immersion_integrals, MeanForceCalibration, MeanForces,
+    calibrate_mean_forces, calibrate_mean_forces_general, immersion_integrals,
+    MeanForceCalibration, MeanForceDesign, MeanForces,
 };
 pub use model::{
-    coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel,
+    coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel, NB, ND,
 };
 pub use multi_test::{analyse_tests, MultiTestResult, PeakTest, TestResult};
 pub use peak_coefficients::{coefficients_at_peak, PeakCoefficients};

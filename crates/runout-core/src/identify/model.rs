@@ -1,17 +1,38 @@
 //! Fast one-revolution force model with analytic derivatives, for waveform fitting.
 //!
-//! Same discretisation and equations as [`crate::ForceModel::simulate`] with [`crate::ArcChip`]
-//! (axial disks at mid-heights, arc chip h = max(0, min_m [f_{i,m} sin φ + R_i − R_{i−m}]) with
-//! exact radii R_i(z) = |R(z)u(ψ_i(z)) + e₀ + zτ|, edge forces only where h > 0), evaluated on a
-//! one-revolution grid θ_q = θ₀ + 2πq/N. Because the forces are linear in the six coefficients
-//! once h is known, the model keeps per-sample **basis sums**
+//! Same discretisation and equations as [`crate::ForceModel::simulate`] with [`crate::ArcChip`],
+//! from the same per-disk table [`crate::edge::EdgeTable`] (axial disks at mid-heights, local
+//! radius R(z), lead angle κ(z), chip width db = dz/sin κ and immersion window per disk; arc chip
+//! h = max(0, min_m [f_{i,m} sin φ + R_i − R_{i−m}]) with exact radii
+//! R_i(z) = |R(z)u(ψ_i(z)) + e₀ + zτ|, normal chip h·sin κ, edge forces only where h > 0),
+//! evaluated on a one-revolution grid θ_q = θ₀ + 2πq/N. Because the forces are linear in the six
+//! coefficients once h is known (and K_c·h sin κ·db = K_c·h·dz), the model keeps per-sample
+//! **basis sums** ([`NB`] = 16; w = h·dz for the shear rows, w = db for the edge rows,
+//! s_κ = sin κ, c_κ = cos κ):
 //!
-//! S = [Σh·cos φ, Σh·sin φ, Σcos φ, Σsin φ, Σh, Σ1]·dz   (over teeth and disks in cut, h > 0)
+//! | row | sum | row | sum |
+//! |---|---|---|---|
+//! | 0 | Σ h dz cos φ | 8 | Σ s_κ db cos φ |
+//! | 1 | Σ h dz sin φ | 9 | Σ s_κ db sin φ |
+//! | 2 | Σ db cos φ | 10 | Σ c_κ h dz cos φ |
+//! | 3 | Σ db sin φ | 11 | Σ c_κ h dz sin φ |
+//! | 4 | Σ s_κ h dz | 12 | Σ c_κ db cos φ |
+//! | 5 | Σ s_κ db | 13 | Σ c_κ db sin φ |
+//! | 6 | Σ s_κ h dz cos φ | 14 | Σ c_κ h dz |
+//! | 7 | Σ s_κ h dz sin φ | 15 | Σ c_κ db |
 //!
-//! so that F_x = K_tc S₀ + K_rc S₁ + K_te S₂ + K_re S₃, F_y = −K_tc S₁ + K_rc S₀ − K_te S₃ + K_re S₂,
-//! F_z = −K_ac S₄ − K_ae S₅ (forces on the workpiece, `force` module docs), plus the derivatives
-//! of [Σh cos φ, Σh sin φ, Σh] w.r.t. the runout vector e₀ (and tilt τ):
-//! ∂h/∂e = n_i − n_{i−m*}, n_i = (R u_i + e(z))/R_i, m* the active term of the min;
+//! so that (forces on the workpiece, [`crate::ForceModel::simulate`])
+//!
+//! F_x = K_tc S₀ + K_rc S₇ − K_ac S₁₁ + K_te S₂ + K_re S₉ − K_ae S₁₃,
+//! F_y = −K_tc S₁ + K_rc S₆ − K_ac S₁₀ − K_te S₃ + K_re S₈ − K_ae S₁₂,
+//! F_z = −K_rc S₁₄ − K_re S₁₅ − K_ac S₄ − K_ae S₅.
+//!
+//! On a cylinder (s_κ = 1, c_κ = 0, db = dz) rows 6–9 repeat rows 0–3, rows 10–15 vanish and rows
+//! 0–5 are the six sums of the flat model [Σh cos φ, Σh sin φ, Σcos φ, Σsin φ, Σh, Σ1]·dz: the
+//! flat kernel accumulates only those and fills the rest.
+//! Derivatives w.r.t. the runout vector e₀ (and tilt τ) of the shear rows
+//! [S₀, S₁, S₄, S₆, S₇, S₁₀, S₁₁, S₁₄] ([`ND`] = 8):
+//! ∂h/∂e = n_i − n_{i−m*}, n_i = (R(z) u_i + e(z))/R_i, m* the active term of the min;
 //! ∂h/∂τ = z·∂h/∂e. (The edge-force switch at h = 0 is not differentiated: measure zero.)
 
 use super::waveform::Axis;
@@ -19,31 +40,24 @@ use crate::angle::wrap_tau;
 use crate::coefficients::CuttingCoefficients;
 use crate::cut::Cut;
 use crate::cutter::Cutter;
+use crate::edge::EdgeTable;
 use rayon::prelude::*;
 use std::f64::consts::TAU;
 
-/// Per (disk, tooth) geometry.
-#[derive(Debug, Clone, Copy)]
-struct Slice {
-    psi: f64,
-    cos_psi: f64,
-    sin_psi: f64,
-}
+/// Number of basis sums per sample (module docs).
+pub const NB: usize = 16;
+/// Number of runout-derivative sums per sample and parameter (module docs).
+pub const ND: usize = 8;
 
 /// One-revolution evaluator for a cutter, cut and angle grid.
 #[derive(Debug, Clone)]
 pub struct RevolutionModel {
     k: usize,
     disks: usize,
-    dz: f64,
-    heights: Vec<f64>,
-    /// R(z_j) per disk.
-    radius: Vec<f64>,
-    slices: Vec<Slice>,
+    /// The shared per-disk geometry and engagement.
+    table: EdgeTable,
     /// f_{i,m} = f_z·K·gap(i, m)/2π, index i*K + m − 1.
     feed: Vec<f64>,
-    st: f64,
-    width: f64,
     /// (θ, sin θ, cos θ) per grid sample.
     grid: Vec<(f64, f64, f64)>,
     /// Apply the edge forces over the whole engagement window instead of only where h > 0
@@ -55,10 +69,12 @@ pub struct RevolutionModel {
 /// Per-sample basis sums and runout derivatives (see module docs).
 #[derive(Debug, Clone)]
 pub struct BasisSums {
-    /// `base[q]` = [Σh cos, Σh sin, Σcos, Σsin, Σh, Σ1]·dz.
-    pub base: Vec<[f64; 6]>,
-    /// `deriv[q][p]` = ∂[Σh cos, Σh sin, Σh]·dz/∂p for p = e_x, e_y (mm), then τ_x, τ_y (mm/mm).
-    pub deriv: Vec<Vec<[f64; 3]>>,
+    /// `base[q]` = the [`NB`] basis sums of sample q (module docs; rows 0–5 are
+    /// [Σh cos, Σh sin, Σcos, Σsin, Σh, Σ1]·dz on a cylinder).
+    pub base: Vec<[f64; NB]>,
+    /// `deriv[q][p]` = ∂[S₀, S₁, S₄, S₆, S₇, S₁₀, S₁₁, S₁₄]/∂p for p = e_x, e_y (mm), then
+    /// τ_x, τ_y (mm/mm).
+    pub deriv: Vec<Vec<[f64; ND]>>,
 }
 
 impl RevolutionModel {
@@ -66,28 +82,13 @@ impl RevolutionModel {
     pub fn new(cutter: &Cutter, cut: &Cut, start_angle: f64, samples: usize, disks: usize) -> Self {
         let k = cutter.teeth();
         let disks = disks.max(1);
-        let dz = cut.ap() / disks as f64;
-        let heights: Vec<f64> = (0..disks).map(|j| (j as f64 + 0.5) * dz).collect();
-        let slices = heights
-            .iter()
-            .flat_map(|&z| {
-                (0..k).map(move |i| {
-                    let psi = cutter.tooth_angle(i, z);
-                    Slice {
-                        psi,
-                        cos_psi: psi.cos(),
-                        sin_psi: psi.sin(),
-                    }
-                })
-            })
-            .collect();
+        let table = EdgeTable::new(cutter, cut, disks);
         let mut feed = Vec::with_capacity(k * k);
         for i in 0..k {
             for m in 1..=k {
                 feed.push(cut.fz() * k as f64 * cutter.gap(i, m) / TAU);
             }
         }
-        let (st, ex) = cut.immersion(cutter);
         let grid = (0..samples)
             .map(|q| {
                 let t = start_angle + TAU * q as f64 / samples as f64;
@@ -98,13 +99,8 @@ impl RevolutionModel {
         RevolutionModel {
             k,
             disks,
-            dz,
-            radius: heights.iter().map(|&z| cutter.radius_at(z)).collect(),
-            heights,
-            slices,
+            table,
             feed,
-            st,
-            width: ex - st,
             grid,
             edge_in_window: false,
         }
@@ -115,10 +111,26 @@ impl RevolutionModel {
         self.grid.len()
     }
 
+    /// True when κ = 90° on every disk: basis rows 6–9 repeat rows 0–3 and rows 10–15 are zero.
+    pub fn is_flat(&self) -> bool {
+        self.table.is_flat()
+    }
+
+    /// The per-disk geometry and engagement table.
+    pub fn table(&self) -> &EdgeTable {
+        &self.table
+    }
+
     /// Basis sums for runout offset `e` (mm) and tilt `tau` (mm/mm); `tilt_derivs` adds the
     /// τ derivatives.
     pub fn sums(&self, e: [f64; 2], tau: [f64; 2], tilt_derivs: bool) -> BasisSums {
         self.compute(e, tau, if tilt_derivs { 4 } else { 2 })
+    }
+
+    /// [`RevolutionModel::sums`] through the κ(z) kernel also on a cylinder (verification and
+    /// benchmarks: on a flat end mill the results are the same).
+    pub fn sums_general(&self, e: [f64; 2], tau: [f64; 2], tilt_derivs: bool) -> BasisSums {
+        self.compute_kernel::<true>(e, tau, if tilt_derivs { 4 } else { 2 })
     }
 
     /// Basis sums only (no derivatives): `deriv` is empty per sample.
@@ -128,17 +140,43 @@ impl RevolutionModel {
 
     /// Samples are independent: evaluated in parallel (rayon), `np` derivatives per sample.
     fn compute(&self, e: [f64; 2], tau: [f64; 2], np: usize) -> BasisSums {
+        if self.table.is_flat() {
+            let mut s = self.compute_kernel::<false>(e, tau, np);
+            for b in &mut s.base {
+                b.copy_within(0..4, 6);
+            }
+            for d in s.deriv.iter_mut().flatten() {
+                d[3] = d[0];
+                d[4] = d[1];
+            }
+            s
+        } else {
+            self.compute_kernel::<true>(e, tau, np)
+        }
+    }
+
+    /// The kernel; `GENERAL = false` accumulates only the cylinder's rows 0–5 (derivative rows
+    /// 0–2), which is exact when κ = 90° on every disk.
+    fn compute_kernel<const GENERAL: bool>(
+        &self,
+        e: [f64; 2],
+        tau: [f64; 2],
+        np: usize,
+    ) -> BasisSums {
         let k = self.k;
         // per disk: radii, unit normals, and the per-tooth active differences are sample-independent
         let mut dr = vec![0.0; self.disks * k * k];
         let mut dn = vec![[0.0f64; 2]; self.disks * k * k];
         for j in 0..self.disks {
-            let z = self.heights[j];
+            let disk = self.table.disk(j);
+            let z = disk.z;
             let ez = [e[0] + z * tau[0], e[1] + z * tau[1]];
-            let r = self.radius[j];
-            let pts: Vec<([f64; 2], f64)> = (0..k)
-                .map(|i| {
-                    let sl = &self.slices[j * k + i];
+            let r = disk.radius;
+            let pts: Vec<([f64; 2], f64)> = self
+                .table
+                .elements(j)
+                .iter()
+                .map(|sl| {
                     let p = [r * sl.cos_psi + ez[0], r * sl.sin_psi + ez[1]];
                     let ri = p[0].hypot(p[1]);
                     ([p[0] / ri, p[1] / ri], ri)
@@ -158,22 +196,29 @@ impl RevolutionModel {
         // `wrap(θ + ψ − φ_st) ≤ width` as the simulation. Disks in parallel (rayon), reduced.
         let n = self.grid.len();
         let dtheta = TAU / n as f64;
-        let run = ((self.width / dtheta).floor() as usize + 3).min(n);
         let theta0 = self.grid.first().map(|g| g.0).unwrap_or(0.0);
-        let empty = || (vec![[0.0f64; 6]; n], vec![[0.0f64; 3]; n * np]);
-        let disk = |(mut b, mut d): (Vec<[f64; 6]>, Vec<[f64; 3]>), j: usize| {
-            let z = self.heights[j];
-            let dz = self.dz;
-            for i in 0..k {
-                let sl = &self.slices[j * k + i];
-                let a = wrap_tau(theta0 + sl.psi - self.st);
+        type Acc = (Vec<[f64; NB]>, Vec<[f64; ND]>);
+        let empty = || (vec![[0.0f64; NB]; n], vec![[0.0f64; ND]; n * np]);
+        let disk = |(mut b, mut d): Acc, j: usize| {
+            let geo = self.table.disk(j);
+            let z = geo.z;
+            let dz = geo.dz;
+            let db = geo.db;
+            let (sk, ck) = (geo.sin_kappa, geo.cos_kappa);
+            let (st, width) = (geo.entry, geo.width);
+            if width.is_nan() || width < 0.0 {
+                return (b, d);
+            }
+            let run = ((width / dtheta).floor() as usize + 3).min(n);
+            for (i, sl) in self.table.elements(j).iter().enumerate() {
+                let a = wrap_tau(theta0 + sl.psi - st);
                 let first = ((TAU - a) / dtheta).floor() as i64 - 1;
                 let base_idx = (j * k + i) * k;
                 for t in 0..run {
                     let q = (first + t as i64).rem_euclid(n as i64) as usize;
                     let (theta, st_t, ct_t) = self.grid[q];
-                    let rel = wrap_tau(theta + sl.psi - self.st);
-                    if rel > self.width {
+                    let rel = wrap_tau(theta + sl.psi - st);
+                    if rel > width {
                         continue;
                     }
                     let s = st_t * sl.cos_psi + ct_t * sl.sin_psi;
@@ -190,19 +235,50 @@ impl RevolutionModel {
                     if h <= 0.0 {
                         if self.edge_in_window {
                             let bq = &mut b[q];
-                            bq[2] += co * dz;
-                            bq[3] += s * dz;
-                            bq[5] += dz;
+                            if GENERAL {
+                                bq[2] += co * db;
+                                bq[3] += s * db;
+                                bq[5] += sk * db;
+                                bq[8] += sk * co * db;
+                                bq[9] += sk * s * db;
+                                bq[12] += ck * co * db;
+                                bq[13] += ck * s * db;
+                                bq[15] += ck * db;
+                            } else {
+                                bq[2] += co * dz;
+                                bq[3] += s * dz;
+                                bq[5] += dz;
+                            }
                         }
                         continue;
                     }
                     let bq = &mut b[q];
-                    bq[0] += h * co * dz;
-                    bq[1] += h * s * dz;
-                    bq[2] += co * dz;
-                    bq[3] += s * dz;
-                    bq[4] += h * dz;
-                    bq[5] += dz;
+                    if GENERAL {
+                        let hz = h * dz;
+                        bq[0] += hz * co;
+                        bq[1] += hz * s;
+                        bq[2] += co * db;
+                        bq[3] += s * db;
+                        bq[4] += sk * hz;
+                        bq[5] += sk * db;
+                        bq[6] += sk * hz * co;
+                        bq[7] += sk * hz * s;
+                        bq[8] += sk * co * db;
+                        bq[9] += sk * s * db;
+                        bq[10] += ck * hz * co;
+                        bq[11] += ck * hz * s;
+                        bq[12] += ck * co * db;
+                        bq[13] += ck * s * db;
+                        bq[14] += ck * hz;
+                        bq[15] += ck * db;
+                    } else {
+                        bq[0] += h * co * dz;
+                        bq[1] += h * s * dz;
+                        bq[2] += co * dz;
+                        bq[3] += s * dz;
+                        bq[4] += h * dz;
+                        bq[5] += dz;
+                    }
                     let g = dn[base_idx + arg];
                     for (p, dp) in d[q * np..(q + 1) * np].iter_mut().enumerate() {
                         let gh = match p {
@@ -213,21 +289,31 @@ impl RevolutionModel {
                         } * dz;
                         dp[0] += gh * co;
                         dp[1] += gh * s;
-                        dp[2] += gh;
+                        if GENERAL {
+                            dp[2] += sk * gh;
+                            dp[3] += sk * gh * co;
+                            dp[4] += sk * gh * s;
+                            dp[5] += ck * gh * co;
+                            dp[6] += ck * gh * s;
+                            dp[7] += ck * gh;
+                        } else {
+                            dp[2] += gh;
+                        }
                     }
                 }
             }
             (b, d)
         };
-        let add = |(mut b1, mut d1): (Vec<[f64; 6]>, Vec<[f64; 3]>),
-                   (b2, d2): (Vec<[f64; 6]>, Vec<[f64; 3]>)| {
+        let add = |(mut b1, mut d1): Acc, (b2, d2): Acc| {
+            let rows = if GENERAL { NB } else { 6 };
+            let drows = if GENERAL { ND } else { 3 };
             for (x, y) in b1.iter_mut().zip(&b2) {
-                for r in 0..6 {
+                for r in 0..rows {
                     x[r] += y[r];
                 }
             }
             for (x, y) in d1.iter_mut().zip(&d2) {
-                for r in 0..3 {
+                for r in 0..drows {
                     x[r] += y[r];
                 }
             }
@@ -248,32 +334,38 @@ impl RevolutionModel {
     }
 }
 
-/// Force component `axis` (N) of sample sums `b` with coefficients `kc`.
+/// Force component `axis` (N) of sample sums `b` with coefficients `kc` (module docs).
 #[inline]
-pub fn force_from_basis(axis: Axis, b: &[f64; 6], kc: &CuttingCoefficients) -> f64 {
+pub fn force_from_basis(axis: Axis, b: &[f64; NB], kc: &CuttingCoefficients) -> f64 {
     match axis {
-        Axis::X => kc.ktc * b[0] + kc.krc * b[1] + kc.kte * b[2] + kc.kre * b[3],
-        Axis::Y => -kc.ktc * b[1] + kc.krc * b[0] - kc.kte * b[3] + kc.kre * b[2],
-        Axis::Z => -kc.kac * b[4] - kc.kae * b[5],
+        Axis::X => {
+            kc.ktc * b[0] + kc.krc * b[7] - kc.kac * b[11] + kc.kte * b[2] + kc.kre * b[9]
+                - kc.kae * b[13]
+        }
+        Axis::Y => {
+            -kc.ktc * b[1] + kc.krc * b[6] - kc.kac * b[10] - kc.kte * b[3] + kc.kre * b[8]
+                - kc.kae * b[12]
+        }
+        Axis::Z => -kc.krc * b[14] - kc.kre * b[15] - kc.kac * b[4] - kc.kae * b[5],
     }
 }
 
 /// Derivatives ∂F_axis/∂(K_tc, K_rc, K_ac, K_te, K_re, K_ae) of sample sums `b`.
 #[inline]
-pub fn coefficient_gradient(axis: Axis, b: &[f64; 6]) -> [f64; 6] {
+pub fn coefficient_gradient(axis: Axis, b: &[f64; NB]) -> [f64; 6] {
     match axis {
-        Axis::X => [b[0], b[1], 0.0, b[2], b[3], 0.0],
-        Axis::Y => [-b[1], b[0], 0.0, -b[3], b[2], 0.0],
-        Axis::Z => [0.0, 0.0, -b[4], 0.0, 0.0, -b[5]],
+        Axis::X => [b[0], b[7], -b[11], b[2], b[9], -b[13]],
+        Axis::Y => [-b[1], b[6], -b[10], -b[3], b[8], -b[12]],
+        Axis::Z => [0.0, -b[14], -b[4], 0.0, -b[15], -b[5]],
     }
 }
 
-/// ∂F_axis/∂p from the runout derivative sums `d` = ∂[Σh cos, Σh sin, Σh]/∂p.
+/// ∂F_axis/∂p from the runout derivative sums `d` = ∂[S₀, S₁, S₄, S₆, S₇, S₁₀, S₁₁, S₁₄]/∂p.
 #[inline]
-pub fn runout_gradient(axis: Axis, d: &[f64; 3], kc: &CuttingCoefficients) -> f64 {
+pub fn runout_gradient(axis: Axis, d: &[f64; ND], kc: &CuttingCoefficients) -> f64 {
     match axis {
-        Axis::X => kc.ktc * d[0] + kc.krc * d[1],
-        Axis::Y => -kc.ktc * d[1] + kc.krc * d[0],
-        Axis::Z => -kc.kac * d[2],
+        Axis::X => kc.ktc * d[0] + kc.krc * d[4] - kc.kac * d[6],
+        Axis::Y => -kc.ktc * d[1] + kc.krc * d[3] - kc.kac * d[5],
+        Axis::Z => -kc.krc * d[7] - kc.kac * d[2],
     }
 }

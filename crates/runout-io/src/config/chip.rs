@@ -46,12 +46,19 @@ pub struct ChipCaseSpec {
     /// Variable pitch (deg), K values summing to 360.
     #[serde(default)]
     pub pitch_deg: Option<Vec<f64>>,
-    /// Radius profile: flat | ball | bull_nose.
+    /// Radius profile: flat | ball | bull_nose | tapered (the vocabulary of every command,
+    /// [`super::radius_profile`]).
     #[serde(default = "default_profile")]
     pub profile: String,
-    /// Corner radius of a bull-nose cutter (mm).
+    /// Corner radius of a bull-nose cutter (mm); older name of `corner_radius_mm`.
     #[serde(default)]
     pub corner_mm: Option<f64>,
+    /// Corner radius of a bull-nose cutter (mm).
+    #[serde(default)]
+    pub corner_radius_mm: Option<f64>,
+    /// Taper (half-cone) angle of a tapered cutter (deg).
+    #[serde(default)]
+    pub taper_deg: Option<f64>,
     /// Spindle speed (rpm).
     pub rpm: f64,
     /// Spindle rotation seen from above: cw | ccw.
@@ -246,18 +253,19 @@ pub fn read_cases(path: &Path) -> Result<Vec<ChipCase>, ChipConfigError> {
 }
 
 fn cutter_of(s: &ChipCaseSpec) -> Result<Cutter, String> {
-    let profile = match s.profile.as_str() {
-        "flat" => RadiusProfile::Flat,
-        "ball" => RadiusProfile::Ball,
-        "bull_nose" => RadiusProfile::BullNose {
-            corner_mm: s.corner_mm.ok_or("bull_nose needs corner_mm")?,
-        },
-        o => {
-            return Err(format!(
-                "profile: expected flat, ball or bull_nose, got `{o}`"
-            ))
-        }
-    };
+    if s.corner_mm.is_some() && s.corner_radius_mm.is_some() {
+        return Err(
+            "corner_radius_mm: give either corner_radius_mm or its older name corner_mm, not both"
+                .into(),
+        );
+    }
+    let profile: RadiusProfile = super::radius_profile(
+        &s.profile,
+        s.diameter_mm,
+        s.corner_radius_mm.or(s.corner_mm),
+        s.taper_deg,
+    )
+    .map_err(|(k, m)| format!("{k}: {m}"))?;
     let pitch = match &s.pitch_deg {
         Some(p) if p.len() != s.teeth => {
             return Err(format!(

@@ -23,6 +23,26 @@ pub const IDENTIFY_KEYS: &[(&str, Quantity, &str)] = &[
     ),
     ("flute_length_mm", Quantity::LengthMm, "flute length (mm)"),
     (
+        "profile",
+        Quantity::Dimensionless,
+        "end profile: flat | ball | bull_nose | tapered [default flat]",
+    ),
+    (
+        "corner_radius_mm",
+        Quantity::LengthMm,
+        "corner radius r_c of a bull_nose cutter (mm), 0 < r_c <= D/2",
+    ),
+    (
+        "taper_deg",
+        Quantity::AngleDeg,
+        "taper (half-cone) angle of a tapered cutter (deg), 0 < α < 45; D is the tip diameter",
+    ),
+    (
+        "flute_lead",
+        Quantity::Dimensionless,
+        "flute winding on a ball, bull-nose or taper: constant_lead | constant_helix [default constant_lead]",
+    ),
+    (
         "rpm",
         Quantity::SpeedRpm,
         "nominal spindle speed (rpm); the actual speed is measured",

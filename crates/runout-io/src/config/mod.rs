@@ -356,3 +356,97 @@ pub fn layer_from_toml(file: &str, text: &str, known: &[&str]) -> Result<Layer, 
         values,
     })
 }
+
+/// The end-profile vocabulary shared by every command that describes a cutter (`simulate`,
+/// `identify`, `chip`): `profile = flat | ball | bull_nose | tapered`, with `corner_radius_mm`
+/// (bull nose only) and `taper_deg` (tapered only).
+pub const PROFILES: &[&str] = &["flat", "ball", "bull_nose", "tapered"];
+
+/// Resolve `profile`, `corner_radius_mm` and `taper_deg` into a [`runout_core::RadiusProfile`]
+/// for a cutter of `diameter_mm`. Errors are `(key, message)`: a bad combination names the
+/// parameter that does not fit (a corner radius on anything but a bull nose, a taper on anything
+/// but a tapered cutter, a corner radius above R, a missing corner radius or taper angle).
+///
+/// ```
+/// use runout_io::config::radius_profile;
+/// use runout_core::RadiusProfile;
+/// assert_eq!(radius_profile("ball", 6.0, None, None).unwrap(), RadiusProfile::Ball);
+/// let (key, msg) = radius_profile("bull_nose", 6.0, Some(4.0), None).unwrap_err();
+/// assert_eq!(key, "corner_radius_mm");
+/// assert!(msg.contains("R = 3"), "{msg}");
+/// assert_eq!(radius_profile("ball", 6.0, None, Some(5.0)).unwrap_err().0, "taper_deg");
+/// ```
+pub fn radius_profile(
+    name: &str,
+    diameter_mm: f64,
+    corner_radius_mm: Option<f64>,
+    taper_deg: Option<f64>,
+) -> Result<runout_core::RadiusProfile, (String, String)> {
+    use runout_core::RadiusProfile;
+    let name = name.trim().to_ascii_lowercase();
+    let r = diameter_mm / 2.0;
+    let err = |k: &str, m: String| Err((k.to_string(), m));
+    if !PROFILES.contains(&name.as_str()) {
+        return err(
+            "profile",
+            format!(
+                "expected one of flat, ball, bull_nose, tapered, got `{}`",
+                clip_quoted(&name)
+            ),
+        );
+    }
+    if let Some(c) = corner_radius_mm {
+        if name != "bull_nose" {
+            return err(
+                "corner_radius_mm",
+                format!(
+                    "a corner radius is only for profile = bull_nose (a ball's is D/2), got {c} mm with profile = {name}"
+                ),
+            );
+        }
+    }
+    if let Some(t) = taper_deg {
+        if name != "tapered" {
+            return err(
+                "taper_deg",
+                format!(
+                    "a taper angle is only for profile = tapered, got {t}° with profile = {name}"
+                ),
+            );
+        }
+    }
+    match name.as_str() {
+        "flat" => Ok(RadiusProfile::Flat),
+        "ball" => Ok(RadiusProfile::Ball),
+        "bull_nose" => {
+            let Some(c) = corner_radius_mm else {
+                return err(
+                    "corner_radius_mm",
+                    "profile = bull_nose needs the corner radius (mm)".into(),
+                );
+            };
+            if !(c.is_finite() && c > 0.0 && c <= r) {
+                return err(
+                    "corner_radius_mm",
+                    format!("expected a corner radius in (0, R = {r}] mm, got {c}"),
+                );
+            }
+            Ok(RadiusProfile::BullNose { corner_mm: c })
+        }
+        _ => {
+            let Some(t) = taper_deg else {
+                return err(
+                    "taper_deg",
+                    "profile = tapered needs the taper (half-cone) angle (deg)".into(),
+                );
+            };
+            if !(t.is_finite() && t > 0.0 && t < 45.0) {
+                return err(
+                    "taper_deg",
+                    format!("expected a taper (half-cone) angle in (0, 45) degrees, got {t}"),
+                );
+            }
+            Ok(RadiusProfile::Tapered { taper_deg: t })
+        }
+    }
+}

@@ -4,8 +4,8 @@
 use super::{ConfigError, Settings};
 use crate::units::Quantity;
 use runout_core::{
-    limits, Cut, Cutter, CuttingCoefficients, MillingMode, ParamError, RadiusProfile, Runout,
-    Sampling,
+    limits, Cut, Cutter, CuttingCoefficients, FluteLead, MillingMode, ParamError, RadiusProfile,
+    Runout, Sampling,
 };
 
 /// Every key of a simulation case: (key, quantity, help). The CLI flag is `--key-with-dashes`.
@@ -26,6 +26,26 @@ pub const SIMULATE_KEYS: &[(&str, Quantity, &str)] = &[
         "flute_length_mm",
         Quantity::LengthMm,
         "flute length (mm) [default unbounded]",
+    ),
+    (
+        "profile",
+        Quantity::Dimensionless,
+        "end profile: flat | ball | bull_nose | tapered [default flat]",
+    ),
+    (
+        "corner_radius_mm",
+        Quantity::LengthMm,
+        "corner radius r_c of a bull_nose cutter (mm), 0 < r_c <= D/2",
+    ),
+    (
+        "taper_deg",
+        Quantity::AngleDeg,
+        "taper (half-cone) angle of a tapered cutter (deg), 0 < α < 45; D is the tip diameter",
+    ),
+    (
+        "flute_lead",
+        Quantity::Dimensionless,
+        "flute winding on a ball, bull-nose or taper: constant_lead | constant_helix [default constant_lead]",
     ),
     ("rpm", Quantity::SpeedRpm, "spindle speed (rpm)"),
     ("fz_mm", Quantity::LengthMm, "feed per tooth f_z (mm)"),
@@ -165,13 +185,28 @@ pub fn resolve_cutter(s: &Settings) -> Result<Cutter, ConfigError> {
     let d = s.require("diameter_mm", Quantity::LengthMm, "cutter diameter")?;
     let helix = s.or("helix_deg", Quantity::AngleDeg, 0.0)?;
     let flute = s.or("flute_length_mm", Quantity::LengthMm, f64::INFINITY)?;
+    let profile = resolve_profile(s, d)?;
+    let lead = match s.text("flute_lead")?.as_deref().map(str::trim) {
+        None | Some("constant_lead") => FluteLead::ConstantLead,
+        Some("constant_helix") => FluteLead::ConstantHelix,
+        Some(o) => {
+            return Err(ConfigError::Key {
+                source_name: s.origin("flute_lead").unwrap_or("config").into(),
+                key: "flute_lead".into(),
+                message: format!(
+                    "expected constant_lead or constant_helix, got `{}`",
+                    super::clip_quoted(o)
+                ),
+            })
+        }
+    };
     let cutter = match s.list("pitch_deg", Quantity::AngleDeg)? {
         None => Cutter::new(
             d,
             vec![std::f64::consts::TAU / teeth as f64; teeth],
             helix,
             flute,
-            RadiusProfile::Flat,
+            profile.clone(),
         ),
         Some(p) => {
             if p.len() != teeth {
@@ -189,13 +224,27 @@ pub fn resolve_cutter(s: &Settings) -> Result<Cutter, ConfigError> {
                 p.iter().map(|x| x.to_radians()).collect(),
                 helix,
                 flute,
-                RadiusProfile::Flat,
+                profile,
             )
         }
     }
-    .map_err(|e| key_err(s, e))?;
+    .map_err(|e| key_err(s, e))?
+    .with_lead(lead);
 
     Ok(cutter)
+}
+
+/// The end-profile keys (`profile`, `corner_radius_mm`, `taper_deg`) for a cutter of
+/// diameter `d` (mm), through the shared vocabulary [`super::radius_profile`].
+pub fn resolve_profile(s: &Settings, d: f64) -> Result<RadiusProfile, ConfigError> {
+    let name = s.text("profile")?.unwrap_or_else(|| "flat".into());
+    let corner = s.quantity("corner_radius_mm", Quantity::LengthMm)?;
+    let taper = s.quantity("taper_deg", Quantity::AngleDeg)?;
+    super::radius_profile(&name, d, corner, taper).map_err(|(key, message)| ConfigError::Key {
+        source_name: s.origin(&key).unwrap_or("config").into(),
+        key,
+        message,
+    })
 }
 
 /// The cut keys (`rpm`, `mode`, `ae_mm` or `entry_deg`/`exit_deg`) with a given feed per tooth
