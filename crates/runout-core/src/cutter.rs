@@ -282,6 +282,25 @@ impl Cutter {
         }
     }
 
+    /// dψ/dz (rad/mm), the slope of [`Cutter::lag`]: tan β₀ / R₀ for constant-lead flutes (and
+    /// every flat end mill), tan β₀ / (R(z)·sin κ(z)) for constant-helix flutes (Engin &
+    /// Altintas 2001, §2.2), evaluated at z ≥ 1e-9 mm (the ball's tip is singular).
+    ///
+    /// ```
+    /// use runout_core::{Cutter, RadiusProfile};
+    /// let c = Cutter::flat(10.0, 4, 30.0).unwrap();
+    /// assert!((c.lag_slope(2.0) - 30f64.to_radians().tan() / 5.0).abs() < 1e-15);
+    /// ```
+    pub fn lag_slope(&self, z: f64) -> f64 {
+        let t = self.tan_helix;
+        if self.lead == FluteLead::ConstantLead || t == 0.0 {
+            return t / self.radius;
+        }
+        let z = z.max(1e-9);
+        let (sin_kappa, _) = self.lead_sin_cos(z);
+        t / (self.radius_at(z) * sin_kappa)
+    }
+
     /// Axial immersion (lead) angle κ(z) (rad) between the tool axis and the outward normal of
     /// the envelope at height z (Lee & Altintas 1996; Engin & Altintas 2001): 90° on a
     /// cylinder; ball: sin κ = R(z)/R, cos κ = (R − z)/R; bull nose: sin κ = (R(z) − R + r_c)/r_c

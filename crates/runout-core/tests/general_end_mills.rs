@@ -616,3 +616,47 @@ fn ball_round_trip_on_a_synchronous_grid() {
         assert!((g - t).abs() <= 3.5 * se.unwrap(), "{:?}", fit.coefficients);
     }
 }
+
+/// The lag slope used by the chip kinematics' z-derivative equals the derivative of the lag
+/// itself, for both flute laws on every profile (central difference, step 1e-5 mm: truncation
+/// ~h²·ψ‴ ≲ 1e-9 rad/mm away from the ball's tip; tolerance 1e-6 relative). And the chip
+/// kinematics' spindle point carries that slope (its dxy is the z-derivative of its xy).
+#[test]
+fn lag_slope_is_the_derivative_of_the_lag_for_both_flute_laws() {
+    for profile in profiles() {
+        for lead in [FluteLead::ConstantLead, FluteLead::ConstantHelix] {
+            let c = cutter(6.0, 3, 30.0, profile.clone()).with_lead(lead);
+            for z in [0.05, 0.4, 0.9, 1.7, 2.5, 4.0] {
+                let h = 1e-5;
+                let fd = (c.lag(z + h) - c.lag(z - h)) / (2.0 * h);
+                let slope = c.lag_slope(z);
+                assert!(
+                    (fd - slope).abs() <= 1e-6 * slope.abs().max(1e-3),
+                    "{profile:?} {lead:?} z {z}: finite difference {fd}, lag_slope {slope}"
+                );
+            }
+            let runout = Runout::new(0.005, 0.3).unwrap();
+            let kin = chip::ToolKinematics::new(
+                &c,
+                &runout,
+                6000.0,
+                0.0,
+                chip::SpindleSense::CounterClockwise,
+                chip::StraightFeed::along_x(30.0),
+            )
+            .unwrap();
+            for z in [0.4, 1.7] {
+                let h = 1e-5;
+                let (a, b) = (kin.spindle_point(1, z - h), kin.spindle_point(1, z + h));
+                let d = kin.spindle_point(1, z).dxy;
+                for k in 0..2 {
+                    let fd = (b.xy[k] - a.xy[k]) / (2.0 * h);
+                    assert!(
+                        (fd - d[k]).abs() < 1e-5,
+                        "{profile:?} {lead:?} z {z}: dxy {d:?} vs {fd}"
+                    );
+                }
+            }
+        }
+    }
+}

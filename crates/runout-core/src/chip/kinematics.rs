@@ -869,7 +869,7 @@ impl<M: ToolMotion> ToolKinematics<M> {
     fn spindle_point_sc(&self, (s, c): (f64, f64), z: f64) -> SpindlePoint {
         let r = self.cutter.radius_at(z);
         let dr = radius_slope(&self.cutter, z);
-        let dpsi = -self.cutter.tan_helix() / self.cutter.radius();
+        let dpsi = -self.cutter.lag_slope(z);
         // e(z) = e₀ + z·τ with e₀ cached (Runout::vector_at would take a libm sin_cos per call)
         let tau = self.runout.tilt();
         let e = [self.offset0[0] + z * tau[0], self.offset0[1] + z * tau[1]];
