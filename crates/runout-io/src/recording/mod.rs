@@ -36,6 +36,7 @@ pub use axis::AxisMappingError;
 pub use axis::{Axis, AxisMapping, AxisSource, ResolvedAxes};
 pub use error::RecordingError;
 pub use reader::{RecordingReader, DEFAULT_CHUNK_ROWS};
+pub use crate::formats::{open_recording, recording_from_bytes};
 pub use writer::{read_binary, BinaryLayout, BinaryWriter, CsvWriter, BINARY_MAGIC};
 
 use serde::Serialize;
@@ -118,6 +119,20 @@ pub enum Format {
         /// The version on line 1 (`Version 2.5.1.2`).
         version: String,
     },
+    /// A MATLAB .mat file (`5` or `7.3`).
+    Mat {
+        /// MAT-file version.
+        version: String,
+    },
+    /// An NI TDMS file.
+    Tdms {
+        /// TDMS version (4712 or 4713).
+        version: u32,
+    },
+    /// An HDF5 file.
+    Hdf5,
+    /// An Apache Parquet file.
+    Parquet,
 }
 
 /// One column of the header.
