@@ -72,7 +72,8 @@ pub fn detect_file(path: &Path) -> std::io::Result<Kind> {
     let n = read_full(&mut f, &mut head)?;
     head.truncate(n);
     let k = detect(&head);
-    if k != Kind::Text || n < 132 {
+    // a MATLAB v7.3 file starts with MAT text, then HDF5 at 512
+    if !matches!(k, Kind::Text | Kind::Mat5) || n < 132 {
         return Ok(k);
     }
     let len = f.metadata()?.len();
@@ -85,7 +86,7 @@ pub fn detect_file(path: &Path) -> std::io::Result<Kind> {
         }
         off *= 2;
     }
-    Ok(Kind::Text)
+    Ok(k)
 }
 
 fn read_full(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {

@@ -238,6 +238,9 @@ impl Obj {
 /// Split a TDMS object path `/'Group'/'Ch''x'` into its components.
 fn split_path(path: &str) -> Option<Vec<String>> {
     let mut parts = Vec::new();
+    if path == "/" {
+        return Some(parts);
+    }
     let b: Vec<char> = path.chars().collect();
     let mut i = 0;
     while i < b.len() {
@@ -576,7 +579,7 @@ fn parse_index<R: Read + Seek>(src: &mut R, file_len: u64, file: &str) -> Result
                     0 => Some(objects[id].last_index.clone().ok_or_else(|| {
                         m.err(&format!("object `{path}`: raw data index \"same as previous\" but no previous segment had one"))
                     })?),
-                    0x6912_0000 | 0x6913_0000 => {
+                    0x1269 | 0x126A | 0x6912_0000 | 0x6913_0000 => {
                         let code = m.u32("DAQmx data type")?;
                         let dim = m.u32("array dimension")?;
                         let count = m.u64("number of values")?;
@@ -592,7 +595,7 @@ fn parse_index<R: Read + Seek>(src: &mut R, file_len: u64, file: &str) -> Result
                             let dt = m.u32("scaler data type")?;
                             let buffer = m.u32("raw buffer index")?;
                             let off = m.u32("raw byte offset")?;
-                            let (byte_offset, bit) = if ilen == 0x6913_0000 {
+                            let (byte_offset, bit) = if ilen == 0x6913_0000 || ilen == 0x126A {
                                 m.take(1, "sample format bitmap")?;
                                 ((off / 8) as u64, Some(off % 8))
                             } else {
