@@ -535,7 +535,7 @@ fn open(
 ) -> Result<RecordingReader<std::io::BufReader<std::fs::File>>> {
     let mut o = ReadOptions::new().channels(names).chunk_rows(65_536);
     o.sample_rate_hz = r.sample_rate_hz;
-    RecordingReader::open(path, &o).map_err(|e| match e {
+    runout_io::recording::open_recording(path, &o).map_err(|e| match e {
         RecordingError::NoSampleRate { .. } => {
             anyhow::anyhow!("{e}\n(or set [recording] sample_rate_hz in the config)")
         }
@@ -1401,7 +1401,7 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
         Err(e) if e.to_string().contains("no sample rate") => {
             let mut o = ReadOptions::new().channels(&names);
             o.sample_rate_hz = Some(1.0);
-            RecordingReader::open(&a.recording, &o)?
+            runout_io::recording::open_recording(&a.recording, &o)?
         }
         other => other?,
     };

@@ -8,7 +8,8 @@
 use super::{Catalog, Entry, Opened, Result, Source};
 use crate::recording::{Format, RecordingError};
 use arrow_array::{Array, ArrayRef, PrimitiveArray};
-use parquet::arrow::arrow_reader::{ParquetRecordBatchReaderBuilder, ProjectionMask};
+use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use parquet::arrow::ProjectionMask;
 use parquet::file::reader::ChunkReader;
 use std::path::Path;
 
