@@ -173,7 +173,8 @@ fn same_recording_in_csv_mat_tdms_gives_identical_identification() {
         dir.path(),
         "dynoware",
     );
-    let mut sets: Vec<(&str, Vec<PathBuf>)> = vec![("csv", vec![]), ("mat", vec![]), ("tdms", vec![])];
+    let mut sets: Vec<(&str, Vec<PathBuf>)> =
+        vec![("csv", vec![]), ("mat", vec![]), ("tdms", vec![])];
     for f in FEEDS {
         let [t, x, y, z] = columns(f);
         let stem = f.trim_end_matches(".txt");
@@ -184,7 +185,16 @@ fn same_recording_in_csv_mat_tdms_gives_identical_identification() {
         }
         std::fs::write(&csv, text).unwrap();
         let mat = dir.path().join(format!("{stem}.mat"));
-        write_mat(&mat, &[("t", &t), ("Fx", &x), ("Fy", &y), ("Fz", &z), ("fs", &[10000.0])]);
+        write_mat(
+            &mat,
+            &[
+                ("t", &t),
+                ("Fx", &x),
+                ("Fy", &y),
+                ("Fz", &z),
+                ("fs", &[10000.0]),
+            ],
+        );
         let tdms = dir.path().join(format!("{stem}.bin")); // detected by content
         write_tdms(&tdms, &[("time", &t), ("Fx", &x), ("Fy", &y), ("Fz", &z)]);
         sets[0].1.push(csv);
@@ -229,7 +239,11 @@ fn same_recording_written_by_scipy_nptdms_h5py_pyarrow_gives_identical_identific
     for ext in exts {
         let files: Vec<PathBuf> = FEEDS
             .iter()
-            .map(|f| dir.path().join(f.trim_end_matches(".txt")).join(format!("same.{ext}")))
+            .map(|f| {
+                dir.path()
+                    .join(f.trim_end_matches(".txt"))
+                    .join(format!("same.{ext}"))
+            })
             .collect();
         let v = identify(&files, dir.path(), ext);
         same(&reference, &v, ext).unwrap_or_else(|e| panic!("{ext} differs from DynoWare: {e}"));
@@ -247,7 +261,11 @@ fn inspect_prints_every_format() {
     ] {
         let out = runout().arg("inspect").arg(fx.join(f)).output().unwrap();
         let text = String::from_utf8_lossy(&out.stdout);
-        assert!(out.status.success(), "{f}: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{f}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         assert!(text.contains(want) && text.contains("200"), "{f}: {text}");
     }
     let out = runout()
@@ -268,5 +286,8 @@ fn inspect_prints_every_format() {
     std::fs::write(&p, &b[..40]).unwrap();
     let out = runout().arg("inspect").arg(&p).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success() && err.contains("cut.tdms") && !err.contains("panicked"), "{err}");
+    assert!(
+        !out.status.success() && err.contains("cut.tdms") && !err.contains("panicked"),
+        "{err}"
+    );
 }

@@ -46,7 +46,14 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10)
         .warm_up_time(std::time::Duration::from_secs(1))
         .measurement_time(std::time::Duration::from_secs(4));
-    for f in ["bench.csv", "bench.mat", "bench_z.mat", "bench.tdms", "bench.h5", "bench.parquet"] {
+    for f in [
+        "bench.csv",
+        "bench.mat",
+        "bench_z.mat",
+        "bench.tdms",
+        "bench.h5",
+        "bench.parquet",
+    ] {
         let p = dir.join(f);
         if f.ends_with(".parquet") && !cfg!(feature = "parquet") {
             eprintln!("formats bench: {f} skipped (build with --features parquet)");

@@ -65,7 +65,11 @@ fn check_dir(dir: &Path) -> usize {
         let mut times = Vec::new();
         let mut c = Chunk::default();
         let mut chunks = 0;
-        while r.read_chunk(&mut c, 37).unwrap_or_else(|e| panic!("{key}: {e}")) > 0 {
+        while r
+            .read_chunk(&mut c, 37)
+            .unwrap_or_else(|e| panic!("{key}: {e}"))
+            > 0
+        {
             chunks += 1;
             times.extend_from_slice(&c.time_s);
             for (g, v) in got.iter_mut().zip(&c.values) {
@@ -143,7 +147,10 @@ fn missing_variable_is_named_and_the_contents_listed() {
     let m = e.to_string();
     assert!(matches!(e, RecordingError::MissingChannel { .. }), "{m}");
     assert!(m.contains("mat5_plain.mat") && m.contains("`Fq`"), "{m}");
-    assert!(m.contains("Fx_600 (200 × f64)") && m.contains("comment"), "{m}");
+    assert!(
+        m.contains("Fx_600 (200 × f64)") && m.contains("comment"),
+        "{m}"
+    );
     // an unknown selector
     let e = open_recording(format!("{}:700", p.display()), &ReadOptions::new())
         .err()
@@ -158,7 +165,10 @@ fn missing_variable_is_named_and_the_contents_listed() {
     .err()
     .unwrap()
     .to_string();
-    assert!(e.contains("`Group/Fz`") && e.contains("Group/Fx (200 × DAQmx i16 (scaled)"), "{e}");
+    assert!(
+        e.contains("`Group/Fz`") && e.contains("Group/Fx (200 × DAQmx i16 (scaled)"),
+        "{e}"
+    );
     // HDF5 dataset
     let e = open_recording(
         fixtures().join("plain.h5"),
@@ -167,7 +177,10 @@ fn missing_variable_is_named_and_the_contents_listed() {
     .err()
     .unwrap()
     .to_string();
-    assert!(e.contains("/force/Fw") && e.contains("/force/Fx (200 × f64, N)"), "{e}");
+    assert!(
+        e.contains("/force/Fw") && e.contains("/force/Fx (200 × f64, N)"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -206,6 +219,9 @@ fn inspect_lists_channels_lengths_rates() {
     assert_eq!(fx.sample_rate_hz, Some(1000.0));
     assert_eq!(fx.start_time_s, Some(0.25));
     let c = inspect(&fixtures().join("mat5_struct.mat"), &ReadOptions::new()).unwrap();
-    assert!(c.entries.iter().any(|e| e.name == "rec800.Fy" && e.len == 200));
+    assert!(c
+        .entries
+        .iter()
+        .any(|e| e.name == "rec800.Fy" && e.len == 200));
     assert!(c.entries.iter().any(|e| e.name == "note" && !e.readable));
 }

@@ -20,7 +20,12 @@ const FIXTURES: [&str; 11] = [
 ];
 
 fn fixture(name: &str) -> Vec<u8> {
-    std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(name)).unwrap()
+    std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/fixtures")
+            .join(name),
+    )
+    .unwrap()
 }
 
 /// Open and read everything; an error must name the file.
@@ -49,7 +54,10 @@ fn read_all(name: &str, bytes: &[u8]) {
                     }
                 }
             }
-            Err(e) => assert!(e.to_string().contains(&file), "error without the file name: {e}"),
+            Err(e) => assert!(
+                e.to_string().contains(&file),
+                "error without the file name: {e}"
+            ),
         }
     }
 }
@@ -72,19 +80,28 @@ fn truncated_files_name_what_was_expected() {
         .err()
         .unwrap()
         .to_string();
-    assert!(e.contains("cut.tdms") && e.contains("TDMS byte 0") && e.contains("28 bytes"), "{e}");
+    assert!(
+        e.contains("cut.tdms") && e.contains("TDMS byte 0") && e.contains("28 bytes"),
+        "{e}"
+    );
     let b = fixture("mat5_plain.mat");
     let e = recording_from_bytes("cut.mat", &b[..300], None, &ReadOptions::new())
         .err()
         .unwrap()
         .to_string();
-    assert!(e.contains("cut.mat") && e.contains("truncated") && e.contains("MAT-file byte"), "{e}");
+    assert!(
+        e.contains("cut.mat") && e.contains("truncated") && e.contains("MAT-file byte"),
+        "{e}"
+    );
     let b = fixture("mat5_compressed.mat");
     let e = recording_from_bytes("cut.mat", &b[..400], None, &ReadOptions::new())
         .err()
         .unwrap()
         .to_string();
-    assert!(e.contains("cut.mat") && e.contains("truncated") && e.contains("type 15"), "{e}");
+    assert!(
+        e.contains("cut.mat") && e.contains("truncated") && e.contains("type 15"),
+        "{e}"
+    );
 }
 
 proptest! {

@@ -79,9 +79,13 @@ impl Walk<'_> {
         rate: Option<f64>,
         depth: usize,
     ) -> Result<()> {
-        let (groups, datasets) = g
-            .members()
-            .map_err(|e| herr(self.file, &format!("group `{}`", if path.is_empty() { "/" } else { path }), e))?;
+        let (groups, datasets) = g.members().map_err(|e| {
+            herr(
+                self.file,
+                &format!("group `{}`", if path.is_empty() { "/" } else { path }),
+                e,
+            )
+        })?;
         for d in datasets {
             if self.entries.len() >= MAX_ENTRIES {
                 self.truncated = true;
@@ -138,7 +142,22 @@ impl Walk<'_> {
         e.unit = attr_text(&attrs, &UNIT);
         e.sample_rate_hz = attr_f64(&attrs, &RATE).or(rate);
         if let Some(c) = attr_text(&attrs, &["MATLAB_class"]) {
-            if !numeric || !matches!(c.as_str(), "double" | "single" | "int8" | "uint8" | "int16" | "uint16" | "int32" | "uint32" | "int64" | "uint64" | "logical") {
+            if !numeric
+                || !matches!(
+                    c.as_str(),
+                    "double"
+                        | "single"
+                        | "int8"
+                        | "uint8"
+                        | "int16"
+                        | "uint16"
+                        | "int32"
+                        | "uint32"
+                        | "int64"
+                        | "uint64"
+                        | "logical"
+                )
+            {
                 e.readable = false;
                 e.note = Some(format!("MATLAB class {c}, not a channel"));
             }
@@ -149,7 +168,11 @@ impl Walk<'_> {
         }
         if layout.is_none() {
             e.readable = false;
-            let dims = shape.iter().map(|d| d.to_string()).collect::<Vec<_>>().join("×");
+            let dims = shape
+                .iter()
+                .map(|d| d.to_string())
+                .collect::<Vec<_>>()
+                .join("×");
             e.note = Some(format!("{dims} dataset, not a vector"));
         }
         let keep = e.readable;
@@ -264,7 +287,10 @@ fn build(f: hdf5_reader::Hdf5File, file: &str, mat73: bool) -> Result<Opened> {
         })
         .collect();
     if w.truncated {
-        metadata.push(("note".into(), format!("only the first {MAX_ENTRIES} datasets are listed")));
+        metadata.push((
+            "note".into(),
+            format!("only the first {MAX_ENTRIES} datasets are listed"),
+        ));
     }
     let names = w.entries.iter().map(|e| e.name.clone()).collect();
     Ok(Opened {
@@ -304,6 +330,7 @@ pub fn open_path(path: &Path, file: &str) -> Result<Opened> {
 
 /// Open an HDF5 / MAT v7.3 file held in memory.
 pub fn open_bytes(bytes: &[u8], file: &str) -> Result<Opened> {
-    let f = hdf5_reader::Hdf5File::from_vec(bytes.to_vec()).map_err(|e| herr(file, "cannot open", e))?;
+    let f = hdf5_reader::Hdf5File::from_vec(bytes.to_vec())
+        .map_err(|e| herr(file, "cannot open", e))?;
     build(f, file, is_mat73(bytes))
 }

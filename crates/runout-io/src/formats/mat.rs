@@ -198,7 +198,9 @@ impl Parser<'_> {
                     return Err(err(
                         self.file,
                         at,
-                        format!("expected a variable (data type 14 or 15), found data type {other}"),
+                        format!(
+                            "expected a variable (data type 14 or 15), found data type {other}"
+                        ),
                     ))
                 }
             }
@@ -214,7 +216,10 @@ impl Parser<'_> {
             err(
                 self.file,
                 at,
-                format!("compressed variable ({} bytes) does not inflate: {e}", data.len()),
+                format!(
+                    "compressed variable ({} bytes) does not inflate: {e}",
+                    data.len()
+                ),
             )
         })?;
         if out.len() as u64 > budget {
@@ -253,7 +258,10 @@ impl Parser<'_> {
         if ty != MI_UINT32 || flags.len() != 8 {
             return Err(self.at(
                 &c,
-                format!("array flags: expected 8 bytes of uint32 (type 6), found type {ty}, {} bytes", flags.len()),
+                format!(
+                    "array flags: expected 8 bytes of uint32 (type 6), found type {ty}, {} bytes",
+                    flags.len()
+                ),
             ));
         }
         let f0 = self.u32(flags);
@@ -264,7 +272,10 @@ impl Parser<'_> {
         if ty != MI_INT32 || dims_b.len() < 8 || dims_b.len() % 4 != 0 {
             return Err(self.at(
                 &c,
-                format!("dimensions: expected ≥ 2 int32 (type 5), found type {ty}, {} bytes", dims_b.len()),
+                format!(
+                    "dimensions: expected ≥ 2 int32 (type 5), found type {ty}, {} bytes",
+                    dims_b.len()
+                ),
             ));
         }
         let dims: Vec<u64> = dims_b
@@ -275,9 +286,14 @@ impl Parser<'_> {
         let count = dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d));
         let (ty, name_b) = self.element(&mut c)?;
         if ty != MI_INT8 && ty != MI_UINT8 && ty != MI_UTF8 {
-            return Err(self.at(&c, format!("array name: expected int8 text (type 1), found type {ty}")));
+            return Err(self.at(
+                &c,
+                format!("array name: expected int8 text (type 1), found type {ty}"),
+            ));
         }
-        let own = String::from_utf8_lossy(name_b).trim_end_matches('\0').to_string();
+        let own = String::from_utf8_lossy(name_b)
+            .trim_end_matches('\0')
+            .to_string();
         let (group, name) = match field {
             Some((g, n)) => (Some(g.to_string()), n.to_string()),
             None => (None, own),
@@ -287,12 +303,18 @@ impl Parser<'_> {
             None => name.clone(),
         };
         let gname = group.clone().unwrap_or_default();
-        let dims_text = dims.iter().map(|d| d.to_string()).collect::<Vec<_>>().join("×");
+        let dims_text = dims
+            .iter()
+            .map(|d| d.to_string())
+            .collect::<Vec<_>>()
+            .join("×");
         match class {
             MX_STRUCT => {
                 let (ty, fl) = self.element(&mut c)?;
                 if ty != MI_INT32 || fl.len() != 4 {
-                    return Err(self.at(&c, "struct: expected the field-name length (int32)".into()));
+                    return Err(
+                        self.at(&c, "struct: expected the field-name length (int32)".into())
+                    );
                 }
                 let flen = self.u32(fl) as usize;
                 let (_, names_b) = self.element(&mut c)?;
@@ -340,7 +362,13 @@ impl Parser<'_> {
                     MX_CHAR => "char array",
                     _ => "sparse matrix",
                 };
-                self.push_note(&gname, &full, count.unwrap_or(0), what, &format!("{dims_text} {what}, not a channel"));
+                self.push_note(
+                    &gname,
+                    &full,
+                    count.unwrap_or(0),
+                    what,
+                    &format!("{dims_text} {what}, not a channel"),
+                );
                 Ok(())
             }
             6..=15 => {
@@ -354,17 +382,29 @@ impl Parser<'_> {
                     MI_INT32 | MI_UINT32 | MI_SINGLE => 4,
                     MI_DOUBLE | MI_INT64 | MI_UINT64 => 8,
                     other => {
-                        return Err(self.at(&c, format!("`{full}`: unknown numeric data type {other}")))
+                        return Err(
+                            self.at(&c, format!("`{full}`: unknown numeric data type {other}"))
+                        )
                     }
                 };
                 if real.len() as u64 != count * size {
                     return Err(self.at(
                         &c,
-                        format!("`{full}` ({dims_text}): expected {} bytes of data, found {}", count * size, real.len()),
+                        format!(
+                            "`{full}` ({dims_text}): expected {} bytes of data, found {}",
+                            count * size,
+                            real.len()
+                        ),
                     ));
                 }
                 if complex {
-                    self.push_note(&gname, &full, count, "complex", &format!("{dims_text} complex, not a channel"));
+                    self.push_note(
+                        &gname,
+                        &full,
+                        count,
+                        "complex",
+                        &format!("{dims_text} complex, not a channel"),
+                    );
                     return Ok(());
                 }
                 self.decoded += count * 8;
@@ -395,7 +435,7 @@ impl Parser<'_> {
                     }
                     e.readable = count > 0;
                     if dims.len() > 2 {
-                        e.note = Some(format!("{dims_text}"));
+                        e.note = Some(dims_text.clone());
                     }
                     self.entries.push(e);
                     self.arrays.push(values);
@@ -409,7 +449,10 @@ impl Parser<'_> {
                         };
                         let mut e = Entry::numeric(f, group.clone(), n, rows);
                         e.dtype = dtype.into();
-                        e.note = Some(format!("column {} of the {dims_text} matrix `{full}`", j + 1));
+                        e.note = Some(format!(
+                            "column {} of the {dims_text} matrix `{full}`",
+                            j + 1
+                        ));
                         self.entries.push(e);
                         let s = (j * rows) as usize;
                         self.arrays.push(values[s..s + rows as usize].to_vec());
@@ -418,7 +461,13 @@ impl Parser<'_> {
                 Ok(())
             }
             other => {
-                self.push_note(&gname, &full, count.unwrap_or(0), "unknown", &format!("unknown array class {other}"));
+                self.push_note(
+                    &gname,
+                    &full,
+                    count.unwrap_or(0),
+                    "unknown",
+                    &format!("unknown array class {other}"),
+                );
                 Ok(())
             }
         }
@@ -475,7 +524,10 @@ pub fn open_bytes(bytes: &[u8], file: &str) -> Result<Opened> {
         return Err(err(
             file,
             bytes.len() as u64,
-            format!("truncated: a MAT v5 file starts with a 128-byte header, the file has {} bytes", bytes.len()),
+            format!(
+                "truncated: a MAT v5 file starts with a 128-byte header, the file has {} bytes",
+                bytes.len()
+            ),
         ));
     }
     let big = match &bytes[126..128] {
@@ -500,7 +552,11 @@ pub fn open_bytes(bytes: &[u8], file: &str) -> Result<Opened> {
         arrays: Vec::new(),
     };
     p.top_level(bytes)?;
-    let version = if text.contains("MATLAB 5.0") { "5" } else { "5?" };
+    let version = if text.contains("MATLAB 5.0") {
+        "5"
+    } else {
+        "5?"
+    };
     Ok(Opened {
         catalog: Catalog {
             format: Format::Mat {

@@ -141,8 +141,7 @@ pub fn split_selector(spec: &Path) -> (PathBuf, Option<String>) {
     }
     if let Some(i) = s.rfind(':') {
         let (p, sel) = (&s[..i], &s[i + 1..]);
-        if !sel.is_empty() && !sel.contains(['/', '\\']) && p.len() > 1 && Path::new(p).is_file()
-        {
+        if !sel.is_empty() && !sel.contains(['/', '\\']) && p.len() > 1 && Path::new(p).is_file() {
             return (PathBuf::from(p), Some(sel.to_string()));
         }
     }
@@ -359,7 +358,8 @@ impl BinaryRecording {
                 for (i, e) in catalog.entries.iter().enumerate() {
                     let low = e.short.to_ascii_lowercase();
                     if e.group.is_none()
-                        && (TIME_NAMES.contains(&low.as_str()) || RATE_NAMES.contains(&low.as_str()))
+                        && (TIME_NAMES.contains(&low.as_str())
+                            || RATE_NAMES.contains(&low.as_str()))
                         && !v.iter().any(|c| c.alias.eq_ignore_ascii_case(&e.short))
                     {
                         v.push(Candidate {
@@ -488,7 +488,10 @@ impl BinaryRecording {
         let (rate, rate_source) = if let Some(f) = options.sample_rate_hz {
             (f, "given by the caller".to_string())
         } else if let (Some(f), Some(i)) = (var_rate, rate_var) {
-            (f, format!("from the variable `{}`", catalog.entries[i].name))
+            (
+                f,
+                format!("from the variable `{}`", catalog.entries[i].name),
+            )
         } else if let Some(f) = first.sample_rate_hz {
             (f, format!("from the properties of `{}`", first.name))
         } else if let (Some(f), Some(i)) = (time_rate, time_vec) {
@@ -647,7 +650,10 @@ impl BinaryRecording {
                 if chunk.time_s.len() != n {
                     return Err(RecordingError::Format {
                         file: self.info.file.clone(),
-                        message: format!("time vector: expected {n} samples, got {}", chunk.time_s.len()),
+                        message: format!(
+                            "time vector: expected {n} samples, got {}",
+                            chunk.time_s.len()
+                        ),
                     });
                 }
             }

@@ -66,7 +66,8 @@ impl<T: ChunkReader + Clone + 'static> PqSource<T> {
             return Ok(());
         }
         let file = self.file.clone();
-        let b = ParquetRecordBatchReaderBuilder::try_new(self.data.clone()).map_err(|e| perr(&file, e))?;
+        let b = ParquetRecordBatchReaderBuilder::try_new(self.data.clone())
+            .map_err(|e| perr(&file, e))?;
         let mask = ProjectionMask::leaves(b.parquet_schema(), self.leaf.iter().copied());
         let reader = b
             .with_row_groups(vec![rg])
@@ -80,7 +81,10 @@ impl<T: ChunkReader + Clone + 'static> PqSource<T> {
             for (k, c) in cols.iter_mut().enumerate() {
                 let a = batch.column(k);
                 if !to_f64(a, c) {
-                    return Err(perr(&file, format!("row group {rg}: column {k} is not numeric")));
+                    return Err(perr(
+                        &file,
+                        format!("row group {rg}: column {k} is not numeric"),
+                    ));
                 }
             }
         }
@@ -105,7 +109,14 @@ impl<T: ChunkReader + Clone + Send + 'static> Source for PqSource<T> {
             let a = (s - self.starts[rg]) as usize;
             let b = ((end.min(rows_end)) - self.starts[rg]) as usize;
             if b > col.len() || a >= b {
-                return Err(perr(&self.file, format!("row group {rg}: expected {} rows, decoded {}", rows_end - self.starts[rg], col.len())));
+                return Err(perr(
+                    &self.file,
+                    format!(
+                        "row group {rg}: expected {} rows, decoded {}",
+                        rows_end - self.starts[rg],
+                        col.len()
+                    ),
+                ));
             }
             out.extend_from_slice(&col[a..b]);
             s = end.min(rows_end);
@@ -136,7 +147,12 @@ fn build<T: ChunkReader + Clone + Send + 'static>(data: T, file: &str) -> Result
         .unwrap_or_default();
     let rate = kv
         .iter()
-        .find(|(k, _)| matches!(k.to_ascii_lowercase().as_str(), "fs" | "sample_rate_hz" | "sample_rate"))
+        .find(|(k, _)| {
+            matches!(
+                k.to_ascii_lowercase().as_str(),
+                "fs" | "sample_rate_hz" | "sample_rate"
+            )
+        })
         .and_then(|(_, v)| v.trim().parse::<f64>().ok())
         .filter(|v| v.is_finite() && *v > 0.0);
     let mut entries = Vec::new();
@@ -155,7 +171,8 @@ fn build<T: ChunkReader + Clone + Send + 'static>(data: T, file: &str) -> Result
             e.note = Some("not a numeric column".into());
         }
         // find the leaf with this top-level name
-        let li = (0..leaves.num_columns()).find(|&c| leaves.column(c).path().parts() == [f.name().clone()]);
+        let li = (0..leaves.num_columns())
+            .find(|&c| leaves.column(c).path().parts() == [f.name().clone()]);
         match li {
             Some(l) if e.readable => leaf.push(l),
             _ => {
@@ -167,7 +184,9 @@ fn build<T: ChunkReader + Clone + Send + 'static>(data: T, file: &str) -> Result
         entries.push(e);
     }
     // only readable columns are decoded: remap
-    let readable: Vec<usize> = (0..entries.len()).filter(|&i| entries[i].readable).collect();
+    let readable: Vec<usize> = (0..entries.len())
+        .filter(|&i| entries[i].readable)
+        .collect();
     let mut src = PqSource {
         data,
         file: file.into(),

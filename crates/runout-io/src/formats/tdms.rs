@@ -28,7 +28,7 @@ const TOC_BIG_ENDIAN: u32 = 1 << 6;
 const TOC_DAQMX: u32 = 1 << 7;
 const LEAD_IN: u64 = 28;
 /// Largest metadata block of one segment read into memory.
-const MAX_META: u64 = runout_core::limits::MAX_TABLE_BYTES as u64;
+const MAX_META: u64 = runout_core::limits::MAX_TABLE_BYTES;
 /// Largest byte block read at once when delivering samples.
 const READ_BLOCK: u64 = 8 << 20;
 
@@ -224,7 +224,11 @@ struct Obj {
 
 impl Obj {
     fn prop(&self, key: &str) -> Option<&Prop> {
-        self.props.iter().rev().find(|(k, _)| k == key).map(|(_, v)| v)
+        self.props
+            .iter()
+            .rev()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v)
     }
     fn num(&self, key: &str) -> Option<f64> {
         match self.prop(key) {
@@ -278,8 +282,15 @@ fn split_path(path: &str) -> Option<Vec<String>> {
 #[derive(Debug, Clone)]
 enum Scale {
     Raw,
-    Linear { slope: f64, intercept: f64, input: i64 },
-    Polynomial { coefficients: Vec<f64>, input: i64 },
+    Linear {
+        slope: f64,
+        intercept: f64,
+        input: i64,
+    },
+    Polynomial {
+        coefficients: Vec<f64>,
+        input: i64,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -371,10 +382,7 @@ impl Meta<'_> {
     fn err(&self, what: &str) -> RecordingError {
         RecordingError::Format {
             file: self.file.into(),
-            message: format!(
-                "TDMS metadata byte {}: {what}",
-                self.base + self.pos as u64
-            ),
+            message: format!("TDMS metadata byte {}: {what}", self.base + self.pos as u64),
         }
     }
     fn take(&mut self, n: usize, what: &str) -> Result<&[u8]> {
@@ -490,7 +498,10 @@ fn parse_index<R: Read + Seek>(src: &mut R, file_len: u64, file: &str) -> Result
         if &lead[0..4] != b"TDSm" {
             return Err(ferr(
                 seg_start,
-                format!("segment {seg_no}: expected the tag `TDSm`, found {:?}", &lead[0..4]),
+                format!(
+                    "segment {seg_no}: expected the tag `TDSm`, found {:?}",
+                    &lead[0..4]
+                ),
             ));
         }
         let toc = u32::from_le_bytes([lead[4], lead[5], lead[6], lead[7]]);
@@ -537,7 +548,9 @@ fn parse_index<R: Read + Seek>(src: &mut R, file_len: u64, file: &str) -> Result
             if raw_off > MAX_META {
                 return Err(ferr(
                     seg_start + 20,
-                    format!("segment {seg_no}: {raw_off} bytes of metadata exceed the limit {MAX_META}"),
+                    format!(
+                        "segment {seg_no}: {raw_off} bytes of metadata exceed the limit {MAX_META}"
+                    ),
                 ));
             }
             let mut mb = vec![0u8; raw_off as usize];
@@ -551,7 +564,10 @@ fn parse_index<R: Read + Seek>(src: &mut R, file_len: u64, file: &str) -> Result
             };
             let n_obj = m.u32("object count")?;
             if n_obj as usize > mb.len() / 8 {
-                return Err(m.err(&format!("{n_obj} objects cannot fit in {} bytes of metadata", mb.len())));
+                return Err(m.err(&format!(
+                    "{n_obj} objects cannot fit in {} bytes of metadata",
+                    mb.len()
+                )));
             }
             if toc & TOC_NEW_OBJ_LIST != 0 {
                 list.clear();
@@ -740,13 +756,23 @@ fn layout(
                 dims = widths.iter().map(|&w| (0, w)).collect();
             }
             for s in &scalers {
-                let d = dims
-                    .get_mut(s.buffer as usize)
-                    .ok_or_else(|| format!("scaler of `{}` names raw buffer {} of {}", objects[o].path, s.buffer, widths.len()))?;
+                let d = dims.get_mut(s.buffer as usize).ok_or_else(|| {
+                    format!(
+                        "scaler of `{}` names raw buffer {} of {}",
+                        objects[o].path,
+                        s.buffer,
+                        widths.len()
+                    )
+                })?;
                 d.0 = d.0.max(ix.count);
             }
         }
-        let chunk: u64 = dims.iter().try_fold(0u64, |a, &(n, w)| n.checked_mul(w).and_then(|b| a.checked_add(b))).ok_or("DAQmx chunk size overflows")?;
+        let chunk: u64 = dims
+            .iter()
+            .try_fold(0u64, |a, &(n, w)| {
+                n.checked_mul(w).and_then(|b| a.checked_add(b))
+            })
+            .ok_or("DAQmx chunk size overflows")?;
         if chunk == 0 {
             return Ok(());
         }
@@ -755,11 +781,18 @@ fn layout(
         for &o in with_data {
             let ix = objects[o].cur.clone().ok_or("no index")?;
             let (scalers, _) = ix.daqmx.clone().ok_or("no DAQmx index")?;
-            let s = scalers.first().ok_or_else(|| format!("`{}`: DAQmx data without a scaler", objects[o].path))?;
+            let s = scalers
+                .first()
+                .ok_or_else(|| format!("`{}`: DAQmx data without a scaler", objects[o].path))?;
             let b = s.buffer as usize;
             let (n, w) = dims[b];
             if s.byte_offset + s.dtype.size() > w || !s.dtype.numeric() {
-                return Err(format!("`{}`: DAQmx scaler at byte {} of {} does not fit the raw data width {w}", objects[o].path, s.byte_offset, s.dtype.name()));
+                return Err(format!(
+                    "`{}`: DAQmx scaler at byte {} of {} does not fit the raw data width {w}",
+                    objects[o].path,
+                    s.byte_offset,
+                    s.dtype.name()
+                ));
             }
             let buf_off: u64 = dims[..b].iter().map(|&(n, w)| n * w).sum();
             let mut add = |pos: u64, count: u64, chunks: u64| {
@@ -785,7 +818,11 @@ fn layout(
             if rest > 0 {
                 // short final chunk: buffers in order, as many values as fit
                 let before = buf_off;
-                let fit = if rest > before { ((rest - before) / w).min(n) } else { 0 };
+                let fit = if rest > before {
+                    ((rest - before) / w).min(n)
+                } else {
+                    0
+                };
                 add(start + chunks * chunk + buf_off + s.byte_offset, fit, 1);
             }
         }
@@ -817,9 +854,22 @@ fn layout(
         let mut off = 0;
         for (k, &o) in with_data.iter().enumerate() {
             let dtype = objects[o].cur.as_ref().map(|i| i.dtype).ok_or("no index")?;
-            for (pos, count, ch) in [(start + off, n, chunks), (start + chunks * chunk + off, rest_rows, 1)] {
+            for (pos, count, ch) in [
+                (start + off, n, chunks),
+                (start + chunks * chunk + off, rest_rows, 1),
+            ] {
                 let obj = &mut objects[o];
-                let p = Piece { first: obj.len, pos, count, chunks: ch, chunk_bytes: chunk, stride: row, dtype, big, bit: None };
+                let p = Piece {
+                    first: obj.len,
+                    pos,
+                    count,
+                    chunks: ch,
+                    chunk_bytes: chunk,
+                    stride: row,
+                    dtype,
+                    big,
+                    bit: None,
+                };
                 obj.len += p.len();
                 obj.dtype = Some(dtype);
                 if p.len() > 0 {
@@ -829,7 +879,12 @@ fn layout(
             off += sizes[k].1;
         }
     } else {
-        let chunk: u64 = sizes.iter().try_fold(0u64, |a, &(n, s)| n.checked_mul(s).and_then(|b| a.checked_add(b))).ok_or("chunk size overflows")?;
+        let chunk: u64 = sizes
+            .iter()
+            .try_fold(0u64, |a, &(n, s)| {
+                n.checked_mul(s).and_then(|b| a.checked_add(b))
+            })
+            .ok_or("chunk size overflows")?;
         if chunk == 0 {
             return Ok(());
         }
@@ -841,9 +896,22 @@ fn layout(
             let dtype = objects[o].cur.as_ref().map(|i| i.dtype).ok_or("no index")?;
             let fit = (rest / s).min(n);
             rest -= fit * s;
-            for (pos, count, ch) in [(start + off, n, chunks), (start + chunks * chunk + off, fit, 1)] {
+            for (pos, count, ch) in [
+                (start + off, n, chunks),
+                (start + chunks * chunk + off, fit, 1),
+            ] {
                 let obj = &mut objects[o];
-                let p = Piece { first: obj.len, pos, count, chunks: ch, chunk_bytes: chunk, stride: s, dtype, big, bit: None };
+                let p = Piece {
+                    first: obj.len,
+                    pos,
+                    count,
+                    chunks: ch,
+                    chunk_bytes: chunk,
+                    stride: s,
+                    dtype,
+                    big,
+                    bit: None,
+                };
                 obj.len += p.len();
                 obj.dtype = Some(dtype);
                 if p.len() > 0 {
@@ -873,7 +941,9 @@ impl Source for TdmsSource {
             let p = &pieces[k];
             let i = s - p.first;
             let (c, j) = (i / p.count, i % p.count);
-            let m = (p.count - j).min(end - s).min((READ_BLOCK / p.stride).max(1));
+            let m = (p.count - j)
+                .min(end - s)
+                .min((READ_BLOCK / p.stride).max(1));
             let size = p.dtype.size();
             let pos = p.pos + c * p.chunk_bytes + j * p.stride;
             let bytes = (m - 1) * p.stride + size;
@@ -883,7 +953,9 @@ impl Source for TdmsSource {
                 .and_then(|_| self.src.read_exact(&mut self.buf))
                 .map_err(|e| RecordingError::Format {
                     file: self.file.clone(),
-                    message: format!("TDMS byte {pos}: cannot read {bytes} bytes of channel data ({e})"),
+                    message: format!(
+                        "TDMS byte {pos}: cannot read {bytes} bytes of channel data ({e})"
+                    ),
                 })?;
             for v in 0..m {
                 let o = (v * p.stride) as usize;
@@ -939,7 +1011,10 @@ fn build(mut src: Box<dyn ReadSeek>, file_len: u64, file: &str) -> Result<Opened
             e.dtype = format!("DAQmx {}", e.dtype);
         }
         e.readable = dtype.is_some_and(|d| d.numeric());
-        e.unit = o.prop("unit_string").map(Prop::text).filter(|s| !s.is_empty());
+        e.unit = o
+            .prop("unit_string")
+            .map(Prop::text)
+            .filter(|s| !s.is_empty());
         if let Some(inc) = o.num("wf_increment").filter(|v| v.is_finite() && *v > 0.0) {
             e.sample_rate_hz = Some(1.0 / inc);
         }

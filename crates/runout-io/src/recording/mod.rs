@@ -32,11 +32,11 @@ mod reader;
 mod text;
 mod writer;
 
+pub use crate::formats::{open_recording, recording_from_bytes};
 pub use axis::AxisMappingError;
 pub use axis::{Axis, AxisMapping, AxisSource, ResolvedAxes};
 pub use error::RecordingError;
 pub use reader::{RecordingReader, DEFAULT_CHUNK_ROWS};
-pub use crate::formats::{open_recording, recording_from_bytes};
 pub use writer::{read_binary, BinaryLayout, BinaryWriter, CsvWriter, BINARY_MAGIC};
 
 use serde::Serialize;
