@@ -139,3 +139,30 @@ proptest! {
         read_all(name, &b);
     }
 }
+
+/// A file found by `cargo fuzz` (target `recording_parquet`) on which arrow-buffer 60.1 panics
+/// (`offset + len out of bounds`): a clear error naming the file, the panic contained.
+#[cfg(feature = "parquet")]
+#[test]
+fn parquet_decoder_panic_is_an_error() {
+    let b = fixture("fuzz/parquet-crash-7475dcc9");
+    let name = "crash.parquet";
+    let mut failed = false;
+    match recording_from_bytes(name, &b, None, &ReadOptions::new().sample_rate_hz(1000.0)) {
+        Err(e) => failed = e.to_string().contains(name),
+        Ok(mut r) => {
+            let mut c = Chunk::default();
+            loop {
+                match r.read_chunk(&mut c, 4096) {
+                    Ok(0) => break,
+                    Ok(_) => {}
+                    Err(e) => {
+                        failed = e.to_string().contains(name);
+                        break;
+                    }
+                }
+            }
+        }
+    }
+    assert!(failed, "expected an error naming the file");
+}

@@ -20,6 +20,25 @@ fn perr(file: &str, e: impl std::fmt::Display) -> RecordingError {
     }
 }
 
+/// Run a call into the parquet/arrow crates, turning their panics on malformed files (found by
+/// fuzzing, e.g. `offset + len out of bounds` in arrow-buffer 60.1) into an error naming the file.
+fn guard<T>(file: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+        Ok(r) => r,
+        Err(p) => {
+            let m = p
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            Err(perr(
+                file,
+                format!("malformed file: the decoder failed ({m})"),
+            ))
+        }
+    }
+}
+
 fn to_f64(a: &ArrayRef, out: &mut Vec<f64>) -> bool {
     use arrow_array::types::*;
     macro_rules! prim {
@@ -102,7 +121,8 @@ impl<T: ChunkReader + Clone + Send + 'static> Source for PqSource<T> {
             if rg + 1 >= self.starts.len() {
                 break;
             }
-            self.load(rg)?;
+            let file = self.file.clone();
+            guard(&file, || self.load(rg))?;
             let rows_end = self.starts[rg + 1];
             let Some((_, cols)) = &self.cache else { break };
             let col = &cols[entry];
@@ -239,12 +259,12 @@ pub fn open_path(path: &Path, file: &str) -> Result<Opened> {
         file: file.into(),
         source,
     })?;
-    build(SharedFile(std::sync::Arc::new(f)), file)
+    guard(file, || build(SharedFile(std::sync::Arc::new(f)), file))
 }
 
 /// Open a Parquet file held in memory.
 pub fn open_bytes(bytes: Vec<u8>, file: &str) -> Result<Opened> {
-    build(bytes::Bytes::from(bytes), file)
+    guard(file, || build(bytes::Bytes::from(bytes), file))
 }
 
 /// A file shared by the readers of several row groups.
