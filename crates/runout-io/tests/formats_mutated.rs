@@ -145,7 +145,14 @@ proptest! {
 #[cfg(feature = "parquet")]
 #[test]
 fn parquet_decoder_panic_is_an_error() {
-    let b = fixture("fuzz/parquet-crash-7475dcc9");
+    for crash in ["7475dcc9", "3b91fd98"] {
+        decoder_panic_is_an_error(&format!("fuzz/parquet-crash-{crash}"));
+    }
+}
+
+#[cfg(feature = "parquet")]
+fn decoder_panic_is_an_error(path: &str) {
+    let b = fixture(path);
     let name = "crash.parquet";
     let mut failed = false;
     match recording_from_bytes(name, &b, None, &ReadOptions::new().sample_rate_hz(1000.0)) {
@@ -164,5 +171,5 @@ fn parquet_decoder_panic_is_an_error() {
             }
         }
     }
-    assert!(failed, "expected an error naming the file");
+    assert!(failed, "{path}: expected an error naming the file");
 }
