@@ -173,3 +173,10 @@ fn decoder_panic_is_an_error(path: &str) {
     }
     assert!(failed, "{path}: expected an error naming the file");
 }
+
+/// A file found by `cargo fuzz` (target `recording_hdf5`): dataset dimensions whose product
+/// overflowed (a panic with overflow checks, a wrong length without): Ok or a clear error.
+#[test]
+fn hdf5_dimension_overflow_is_handled() {
+    read_all("hdf5-crash", &fixture("fuzz/hdf5-crash-e98f56d3"));
+}

@@ -115,7 +115,11 @@ impl Walk<'_> {
     fn dataset(&mut self, d: Dataset, dpath: &str, gpath: &str, rate: Option<f64>) {
         let shape = d.shape().to_vec();
         let attrs = d.attributes();
-        let n: u64 = shape.iter().product();
+        // a malformed file may announce dimensions whose product overflows
+        let n: u64 = shape
+            .iter()
+            .try_fold(1u64, |a, &d| a.checked_mul(d))
+            .unwrap_or(u64::MAX);
         let dtype = d.dtype().clone();
         let (numeric, tname) = match &dtype {
             Datatype::FloatingPoint { size, .. } if *size == 4 || *size == 8 => {

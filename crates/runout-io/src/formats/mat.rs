@@ -425,7 +425,13 @@ impl Parser<'_> {
                     14 => "i64",
                     _ => "u64",
                 };
-                let (rows, cols) = (dims[0], dims[1..].iter().product::<u64>());
+                let (rows, cols) = (
+                    dims[0],
+                    dims[1..]
+                        .iter()
+                        .try_fold(1u64, |a, &d| a.checked_mul(d))
+                        .unwrap_or(u64::MAX),
+                );
                 let group = group.clone();
                 if rows <= 1 || cols <= 1 {
                     let mut e = Entry::numeric(full.clone(), group, name.clone(), count);
