@@ -36,6 +36,8 @@ enum Command {
     Grind(cmd::grind::Args),
     /// Cutting force and runout from two-point shank deflection (capacitive sensors).
     Shank(cmd::shank::Args),
+    /// What a recording holds (.mat, TDMS, HDF5, Parquet, CSV): channels, units, lengths, rates.
+    Inspect(cmd::inspect::Args),
 }
 
 /// Status of a command whose standard output was closed early (`runout … | head -1`), as a
@@ -81,6 +83,7 @@ fn main() -> ExitCode {
         Command::Chip(a) => cmd::chip::run(a),
         Command::Grind(a) => cmd::grind::run(a),
         Command::Shank(a) => cmd::shank::run(a),
+        Command::Inspect(a) => cmd::inspect::run(a),
     };
     // outputs appear only when the whole command succeeded (or only its stdout was cut short)
     let result = match result {

@@ -9,6 +9,7 @@ pub mod config;
 pub mod displacement;
 pub mod displacement_plot;
 pub mod export;
+pub mod formats;
 pub mod frf;
 pub mod gcode;
 pub mod grind;

@@ -120,16 +120,8 @@ impl Source {
         options: &ReadOptions,
     ) -> Result<RecordingReader<Box<dyn BufRead + Send>>, RecordingError> {
         match &self.kind {
-            Kind::Path(p) => {
-                let f = std::fs::File::open(p).map_err(|error| RecordingError::Io {
-                    file: self.name.clone(),
-                    error,
-                })?;
-                let size = f.metadata().ok().map(|m| m.len());
-                let src: Box<dyn BufRead + Send> =
-                    Box::new(std::io::BufReader::with_capacity(1 << 16, f));
-                Ok(RecordingReader::from_reader(src, &self.name, options)?.with_file_bytes(size))
-            }
+            // any supported format, detected by content (runout_io::formats)
+            Kind::Path(p) => Ok(runout_io::recording::open_recording(p, options)?.boxed()),
             Kind::Bytes(b) => {
                 let src: Box<dyn BufRead + Send> = Box::new(std::io::Cursor::new(b.clone()));
                 Ok(RecordingReader::from_reader(src, &self.name, options)?

@@ -4,6 +4,7 @@ pub mod chip;
 pub mod displacement;
 pub mod grind;
 pub mod identify;
+pub mod inspect;
 pub mod shank;
 pub mod simulate;
 pub mod simulate_sensor;

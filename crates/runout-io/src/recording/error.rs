@@ -146,4 +146,25 @@ pub enum RecordingError {
         /// What is wrong.
         message: String,
     },
+    /// A binary recording (.mat, TDMS, HDF5, Parquet) is malformed or unsupported; the message
+    /// names the byte offset or the variable and what was expected.
+    #[error("{file}: {message}")]
+    Format {
+        /// The file.
+        file: String,
+        /// What is wrong and what was expected.
+        message: String,
+    },
+    /// A requested variable / channel / dataset is not in a binary recording.
+    #[error("{file}: no {what} `{name}`; the file holds: {available}")]
+    MissingChannel {
+        /// The file.
+        file: String,
+        /// `channel`, `time variable`.
+        what: String,
+        /// The requested name.
+        name: String,
+        /// What the file holds (names, lengths, types).
+        available: String,
+    },
 }

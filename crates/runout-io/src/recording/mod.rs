@@ -32,6 +32,7 @@ mod reader;
 mod text;
 mod writer;
 
+pub use crate::formats::{open_recording, recording_from_bytes};
 pub use axis::AxisMappingError;
 pub use axis::{Axis, AxisMapping, AxisSource, ResolvedAxes};
 pub use error::RecordingError;
@@ -120,6 +121,20 @@ pub enum Format {
         /// The version on line 1 (`Version 2.5.1.2`).
         version: String,
     },
+    /// A MATLAB .mat file (`5` or `7.3`).
+    Mat {
+        /// MAT-file version.
+        version: String,
+    },
+    /// An NI TDMS file.
+    Tdms {
+        /// TDMS version (4712 or 4713).
+        version: u32,
+    },
+    /// An HDF5 file.
+    Hdf5,
+    /// An Apache Parquet file.
+    Parquet,
 }
 
 /// One column of the header.

@@ -128,6 +128,42 @@ pub struct RecordingReader<R> {
     buf: Vec<u8>,
     chunk_rows: usize,
     finished: bool,
+    /// A binary format (.mat, TDMS, HDF5, Parquet) delivering the chunks instead of the lines.
+    binary: Option<Box<crate::formats::BinaryRecording>>,
+}
+
+impl<R: BufRead + Send + 'static> RecordingReader<R> {
+    /// The same reader over a boxed source, so that readers of files, of bytes in memory and of
+    /// the binary formats share one type.
+    pub fn boxed(self) -> RecordingReader<Box<dyn BufRead + Send>> {
+        let LineSource {
+            src,
+            pending,
+            line_no,
+            bytes,
+            file,
+        } = self.lines;
+        RecordingReader {
+            lines: LineSource {
+                src: Box::new(src),
+                pending,
+                line_no,
+                bytes,
+                file,
+            },
+            info: self.info,
+            slots: self.slots,
+            time_scale: self.time_scale,
+            time_column: self.time_column,
+            sample: self.sample,
+            previous_time: self.previous_time,
+            warnings: self.warnings,
+            buf: self.buf,
+            chunk_rows: self.chunk_rows,
+            finished: self.finished,
+            binary: self.binary,
+        }
+    }
 }
 
 impl RecordingReader<BufReader<File>> {
@@ -349,7 +385,34 @@ impl<R: BufRead> RecordingReader<R> {
                 options.chunk_rows
             },
             finished: false,
+            binary: None,
         })
+    }
+
+    /// A reader delivering the chunks of a binary recording (see [`crate::formats`]); `src` is
+    /// not read.
+    pub(crate) fn from_binary(src: R, rec: crate::formats::BinaryRecording) -> Self {
+        let info = rec.info().clone();
+        Self {
+            lines: LineSource {
+                src,
+                pending: VecDeque::new(),
+                line_no: 0,
+                bytes: 0,
+                file: info.file.clone(),
+            },
+            info,
+            slots: Vec::new(),
+            time_scale: 1.0,
+            time_column: 0,
+            sample: 0,
+            previous_time: f64::NEG_INFINITY,
+            warnings: Vec::new(),
+            buf: Vec::new(),
+            chunk_rows: DEFAULT_CHUNK_ROWS,
+            finished: false,
+            binary: Some(Box::new(rec)),
+        }
     }
 
     /// What the header said: format, channels, units, metadata, sample rate.
@@ -359,22 +422,34 @@ impl<R: BufRead> RecordingReader<R> {
 
     /// Non-fatal findings so far (rate given vs header, sample count vs header, unit clashes).
     pub fn warnings(&self) -> &[String] {
+        if let Some(b) = &self.binary {
+            return b.warnings();
+        }
         &self.warnings
     }
 
     /// Bytes consumed from the input so far (for progress bars), including read-ahead.
     pub fn bytes_read(&self) -> u64 {
+        if let Some(b) = &self.binary {
+            return b.bytes_read();
+        }
         self.lines.bytes
     }
 
     /// Samples delivered so far.
     pub fn samples_read(&self) -> u64 {
+        if let Some(b) = &self.binary {
+            return b.samples_read();
+        }
         self.sample
     }
 
     /// Fill `chunk` (cleared first, capacity kept) with up to `max_rows` rows; returns the
     /// number of rows, 0 at the end of the data.
     pub fn read_chunk(&mut self, chunk: &mut Chunk, max_rows: usize) -> Result<usize> {
+        if let Some(b) = &mut self.binary {
+            return b.read_chunk(chunk, max_rows);
+        }
         chunk.first_sample = self.sample;
         chunk.time_s.clear();
         chunk.values.resize_with(self.info.channels.len(), Vec::new);

@@ -326,7 +326,7 @@ fn analyse_file(path: &Path, case: &IdentifyCase, cut: &Cut) -> Result<FileResul
     if let Some(fs) = case.sample_rate_hz {
         opts = opts.sample_rate_hz(fs);
     }
-    let mut reader = RecordingReader::open(path, &opts)?;
+    let mut reader = runout_io::recording::open_recording(path, &opts)?;
     let info = reader.info().clone();
     let names: Vec<String> = info.channels.iter().map(|c| c.name.clone()).collect();
     let mapping = match &case.axes {

@@ -1,0 +1,227 @@
+//! Binary recording formats (issue 16): fixtures written by independent writers (scipy, h5py,
+//! nptdms, pyarrow; `tests/fixtures/make_fixtures.py`) read back exactly, values and time base,
+//! through the one entry point `open_recording`; clear errors for missing names.
+
+use runout_io::formats::{detect, inspect, Kind};
+use runout_io::recording::{open_recording, Chunk, Format, ReadOptions, RecordingError};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures")
+}
+
+/// Read every case of `expected.json` from `dir`; returns the number of cases checked.
+fn check_dir(dir: &Path) -> usize {
+    let text = std::fs::read_to_string(dir.join("expected.json")).unwrap();
+    let cases: serde_json::Map<String, Value> = serde_json::from_str(&text).unwrap();
+    let mut checked = 0;
+    for (key, case) in &cases {
+        let file = case["file"].as_str().unwrap();
+        if file.ends_with(".parquet") && !cfg!(feature = "parquet") {
+            let e = open_recording(dir.join(file), &ReadOptions::new())
+                .err()
+                .expect("a Parquet file without the feature must fail");
+            assert!(e.to_string().contains("--features parquet"), "{e}");
+            continue;
+        }
+        let mut spec = dir.join(file).display().to_string();
+        if let Some(sel) = case["selector"].as_str() {
+            spec += &format!(":{sel}");
+        }
+        let channels: Vec<(&String, Vec<f64>)> = case["channels"]
+            .as_object()
+            .unwrap()
+            .iter()
+            .map(|(k, v)| {
+                (
+                    k,
+                    v.as_array()
+                        .unwrap()
+                        .iter()
+                        .map(|x| x.as_f64().unwrap())
+                        .collect(),
+                )
+            })
+            .collect();
+        let names: Vec<&str> = channels.iter().map(|(k, _)| k.as_str()).collect();
+        let mut opts = ReadOptions::new().channels(&names).chunk_rows(37);
+        if let Some(t) = case["time_var"].as_str() {
+            opts = opts.time_column(t);
+        }
+        let mut r = open_recording(&spec, &opts).unwrap_or_else(|e| panic!("{key}: {e}"));
+        let fs = case["sample_rate_hz"].as_f64().unwrap();
+        let t0 = case["start_time_s"].as_f64().unwrap();
+        let info = r.info().clone();
+        assert!(
+            ((info.sample_rate_hz - fs) / fs).abs() < 1e-9,
+            "{key}: rate {} vs {fs} ({})",
+            info.sample_rate_hz,
+            info.sample_rate_source
+        );
+        assert_eq!(info.start_time_s, t0, "{key}");
+        assert_eq!(info.channels.len(), channels.len(), "{key}");
+        let mut got: Vec<Vec<f64>> = vec![Vec::new(); channels.len()];
+        let mut times = Vec::new();
+        let mut c = Chunk::default();
+        let mut chunks = 0;
+        while r
+            .read_chunk(&mut c, 37)
+            .unwrap_or_else(|e| panic!("{key}: {e}"))
+            > 0
+        {
+            chunks += 1;
+            times.extend_from_slice(&c.time_s);
+            for (g, v) in got.iter_mut().zip(&c.values) {
+                g.extend_from_slice(v);
+            }
+        }
+        assert!(chunks > 1, "{key}: read in several chunks");
+        for ((name, want), g) in channels.iter().zip(&got) {
+            assert_eq!(g, want, "{key}: channel {name}");
+        }
+        let n = got[0].len();
+        let expected_t: Vec<f64> = (0..n).map(|k| t0 + k as f64 / fs).collect();
+        if case["time_var"].is_null() {
+            assert_eq!(times, expected_t, "{key}: time base");
+        } else {
+            for (a, b) in times.iter().zip(&expected_t) {
+                assert!((a - b).abs() < 1e-12, "{key}: time {a} vs {b}");
+            }
+        }
+        checked += 1;
+    }
+    checked
+}
+
+#[test]
+fn committed_fixtures_read_back_exactly() {
+    let n = check_dir(&fixtures());
+    assert!(n >= 15, "only {n} cases");
+}
+
+#[test]
+#[ignore = "needs python3 with scipy, h5py, nptdms, pyarrow: .ci/run installs them"]
+fn fixtures_made_now_by_independent_writers_read_back_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let st = std::process::Command::new("python3")
+        .arg(fixtures().join("make_fixtures.py"))
+        .arg(dir.path())
+        .status()
+        .expect("python3");
+    assert!(st.success());
+    assert!(check_dir(dir.path()) >= 15);
+}
+
+#[test]
+fn detection_by_content_not_extension() {
+    for (f, want) in [
+        ("mat5_plain.mat", Kind::Mat5),
+        ("mat5_compressed.mat", Kind::Mat5),
+        ("mat73.mat", Kind::Hdf5 { offset: 512 }),
+        ("plain.h5", Kind::Hdf5 { offset: 0 }),
+        ("tdms_big_endian.tdms", Kind::Tdms),
+        ("table.parquet", Kind::Parquet),
+    ] {
+        let bytes = std::fs::read(fixtures().join(f)).unwrap();
+        assert_eq!(detect(&bytes), want, "{f}");
+    }
+    // a renamed file is still read by content
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("recording.txt");
+    std::fs::copy(fixtures().join("tdms_interleaved.tdms"), &p).unwrap();
+    let r = open_recording(&p, &ReadOptions::new()).unwrap();
+    assert!(matches!(r.info().format, Format::Tdms { version: 4713 }));
+    assert_eq!(detect(b"Time,Fx\n0,1\n"), Kind::Text);
+}
+
+#[test]
+fn missing_variable_is_named_and_the_contents_listed() {
+    let p = fixtures().join("mat5_plain.mat");
+    let e = open_recording(
+        format!("{}:600", p.display()),
+        &ReadOptions::new().channels(&["Fq"]),
+    )
+    .err()
+    .unwrap();
+    let m = e.to_string();
+    assert!(matches!(e, RecordingError::MissingChannel { .. }), "{m}");
+    assert!(m.contains("mat5_plain.mat") && m.contains("`Fq`"), "{m}");
+    assert!(
+        m.contains("Fx_600 (200 × f64)") && m.contains("comment"),
+        "{m}"
+    );
+    // an unknown selector
+    let e = open_recording(format!("{}:700", p.display()), &ReadOptions::new())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("selector `700`") && e.contains("Fy_800"), "{e}");
+    // TDMS channel
+    let e = open_recording(
+        fixtures().join("tdms_daqmx.tdms"),
+        &ReadOptions::new().channels(&["Group/Fz"]),
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(
+        e.contains("`Group/Fz`") && e.contains("Group/Fx (200 × DAQmx i16 (scaled)"),
+        "{e}"
+    );
+    // HDF5 dataset
+    let e = open_recording(
+        fixtures().join("plain.h5"),
+        &ReadOptions::new().channels(&["/force/Fw"]),
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(
+        e.contains("/force/Fw") && e.contains("/force/Fx (200 × f64, N)"),
+        "{e}"
+    );
+}
+
+#[test]
+fn no_sample_rate_is_a_clear_error_and_the_caller_rate_wins() {
+    let bytes = std::fs::read(fixtures().join("tdms_incremental.tdms")).unwrap();
+    let r = runout_io::recording::recording_from_bytes(
+        "x.tdms",
+        &bytes,
+        None,
+        &ReadOptions::new().channels(&["Fx"]).sample_rate_hz(50.0),
+    )
+    .unwrap();
+    assert_eq!(r.info().sample_rate_hz, 50.0);
+    assert_eq!(r.info().sample_rate_source, "given by the caller");
+    // a MAT file without rate variable or time vector
+    let dir = tempfile::tempdir().unwrap();
+    let q = dir.path().join("norate.mat");
+    let mut b = std::fs::read(fixtures().join("mat5_plain.mat")).unwrap();
+    // rename the variable `fs` → `fq` in place (names are stored as text)
+    let pos = b.windows(4).position(|w| w == b"fs\0\0").unwrap();
+    b[pos + 1] = b'q';
+    std::fs::write(&q, &b).unwrap();
+    let e = open_recording(format!("{}:600", q.display()), &ReadOptions::new())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("no sample rate") && e.contains("fq"), "{e}");
+}
+
+#[test]
+fn inspect_lists_channels_lengths_rates() {
+    let c = inspect(&fixtures().join("tdms_writer.tdms"), &ReadOptions::new()).unwrap();
+    let fx = c.entries.iter().find(|e| e.name == "Force/Fx").unwrap();
+    assert_eq!(fx.len, 200);
+    assert_eq!(fx.unit.as_deref(), Some("N"));
+    assert_eq!(fx.sample_rate_hz, Some(1000.0));
+    assert_eq!(fx.start_time_s, Some(0.25));
+    let c = inspect(&fixtures().join("mat5_struct.mat"), &ReadOptions::new()).unwrap();
+    assert!(c
+        .entries
+        .iter()
+        .any(|e| e.name == "rec800.Fy" && e.len == 200));
+    assert!(c.entries.iter().any(|e| e.name == "note" && !e.readable));
+}
