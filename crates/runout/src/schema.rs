@@ -33,5 +33,6 @@ pub fn all() -> Vec<(&'static str, String, String)> {
         one::<crate::grind::CheckReport>(),
         one::<crate::identify::PeaksReport>(),
         one::<crate::identify::TestsReport>(),
+        one::<crate::identify::RecordingsReport>(),
     ]
 }

@@ -5,10 +5,19 @@
 #![allow(non_snake_case)] // field names carry their units as the JSON does (`mean_N`)
 
 mod peaks;
+mod recordings;
 pub mod render;
+mod render_recordings;
 mod tests;
 
 pub use peaks::{peak_angle, peaks, PeakFitReport, PeaksInputs, PeaksReport, PeaksRequest};
+pub use recordings::{
+    recordings, resolve, Calibration, ChainChoice, ChainDecision, Coefficients, Consistency,
+    Fitted, FullSignal, FullSignalReport, MeanForceN, MeasuringChainReport, Peak, RecordingReport,
+    RecordingRunout, RecordingsInputs, RecordingsReport, RecordingsRequest, Renumbered,
+    SectionReport, SineFitReport, SpindleReport, Status, Verdicts, WaveformPlot,
+};
+pub use render_recordings::recordings_text;
 pub use tests::{
     tests, PolarMean, PooledReport, RegressionPerMm, RegressionPerMm2, TestInputs, TestReport,
     TestsDefaults, TestsReport, TestsRequest,

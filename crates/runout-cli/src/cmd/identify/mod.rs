@@ -4,6 +4,7 @@
 //! CSV/TOML table: per-test fits, regressions, K_T/K_R, pooled edge-aware fit).
 
 pub mod peaks;
+mod plots;
 pub mod recording;
 pub mod tests;
 
