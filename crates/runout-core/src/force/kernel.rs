@@ -269,15 +269,12 @@ fn add_to(a: &mut V, x: &V) {
 /// wrap(θ₀ + ψ − φ_st) at the block's first sample, `width` the window, `step` the sample
 /// spacing. Each vector is visited at most once.
 #[inline(always)]
-fn for_runs(a: f64, width: f64, step: f64, len: usize, mut f: impl FnMut(usize)) {
+fn runs(a: f64, width: f64, step: f64, len: usize, out: &mut Vec<(usize, usize)>) {
+    out.clear();
     let full = padded(len);
     if !(width < TAU - 2.0 * (L as f64 + 2.0) * step) || !a.is_finite() {
         // (almost) always engaged, or an undefined window: every vector
-        let mut t = 0;
-        while t < full {
-            f(t);
-            t += L;
-        }
+        out.push((0, full));
         return;
     }
     let mut done = 0usize;
@@ -290,10 +287,8 @@ fn for_runs(a: f64, width: f64, step: f64, len: usize, mut f: impl FnMut(usize))
         }
         let b0 = ((t0 as usize) / L * L).max(*done);
         let b1 = padded(t1 as usize);
-        let mut t = b0;
-        while t < b1 {
-            f(t);
-            t += L;
+        if b1 > b0 {
+            out.push((b0, b1));
         }
         *done = (*done).max(b1);
     };
@@ -344,6 +339,7 @@ pub(crate) fn accumulate<C: LaneChip, const GENERAL: bool, const SIM: bool>(
         },
     };
     let simc = sim.unwrap_or(&none);
+    let mut spans: Vec<(usize, usize)> = Vec::with_capacity(8);
     for j in disks {
         let disk = table.disk(j);
         let (st, mut width) = (disk.entry, disk.width);
@@ -362,168 +358,222 @@ pub(crate) fn accumulate<C: LaneChip, const GENERAL: bool, const SIM: bool>(
             let (psi, cpsi, spsi) = (el.psi, el.cos_psi, el.sin_psi);
             let radius = simc.radius.get(j * k + i).copied().unwrap_or(0.0);
             let a = wrap_tau(grid.theta[0] + psi - st);
-            for_runs(a, width, grid.step, grid.len, |t| {
-                let th: &V = grid.theta[t..t + L].try_into().expect("lanes");
-                let sth: &V = grid.sin[t..t + L].try_into().expect("lanes");
-                let cth: &V = grid.cos[t..t + L].try_into().expect("lanes");
-                let mut rel = [0.0; L];
-                let mut phi = [0.0; L];
-                let mut s = [0.0; L];
-                let mut co = [0.0; L];
-                let mut win = [false; L];
-                for l in 0..L {
-                    // exactly the scalar model's operations (no fused multiply-add)
-                    let x = th[l] + psi - st;
-                    let w = x - TAU * (x / TAU).floor();
-                    rel[l] = if w >= TAU { 0.0 } else { w };
-                    win[l] = rel[l] <= width;
-                    phi[l] = st + rel[l];
-                    s[l] = sth[l] * cpsi + cth[l] * spsi;
-                    co[l] = cth[l] * cpsi - sth[l] * spsi;
-                }
-                let mut h = [0.0; L];
-                let mut gx = [0.0; L];
-                let mut gy = [0.0; L];
-                chip.eval(j, i, &phi, &s, &co, &mut h, &mut gx, &mut gy);
-                let mut cut = [false; L];
-                let mut edge = [false; L];
-                for l in 0..L {
-                    cut[l] = win[l] && !(h[l] <= 0.0);
-                    edge[l] = if opts.edge_in_window { win[l] } else { cut[l] };
-                }
-                // Each term below is the old loops' expression with the same association, masked
-                // by a select (adding an exact 0 elsewhere): results are bit-identical to them.
-                if SIM {
-                    let kc = &simc.kc;
-                    let mut f = [[0.0; L]; 4];
-                    let mut dxy = [[0.0; L]; 2];
+            runs(a, width, grid.step, grid.len, &mut spans);
+            for &(b0, b1) in &spans {
+                let mut t = b0;
+                while t < b1 {
+                    let th: &V = grid.theta[t..t + L].try_into().expect("lanes");
+                    let sth: &V = grid.sin[t..t + L].try_into().expect("lanes");
+                    let cth: &V = grid.cos[t..t + L].try_into().expect("lanes");
+                    let mut rel = [0.0; L];
+                    let mut phi = [0.0; L];
+                    let mut s = [0.0; L];
+                    let mut co = [0.0; L];
+                    let mut win = [false; L];
                     for l in 0..L {
-                        let (ft, frad, fax) = if GENERAL {
-                            let hz = h[l] * dz;
-                            let ft = kc.ktc * hz + kc.kte * db;
-                            let fr = kc.krc * hz + kc.kre * db;
-                            let fa = kc.kac * hz + kc.kae * db;
-                            (ft, fr * sk - fa * ck, fr * ck + fa * sk)
-                        } else {
-                            (
-                                (kc.ktc * h[l] + kc.kte) * dz,
-                                (kc.krc * h[l] + kc.kre) * dz,
-                                (kc.kac * h[l] + kc.kae) * dz,
-                            )
-                        };
-                        let dx = ft * co[l] + frad * s[l];
-                        let dy = -ft * s[l] + frad * co[l];
-                        let on = cut[l];
-                        dxy[0][l] = if on { dx } else { 0.0 };
-                        dxy[1][l] = if on { dy } else { 0.0 };
-                        f[2][l] = if on { fax } else { 0.0 };
-                        f[3][l] = if on { ft * radius } else { 0.0 };
+                        // exactly the scalar model's operations (no fused multiply-add)
+                        let x = th[l] + psi - st;
+                        let w = x - TAU * (x / TAU).floor();
+                        rel[l] = if w >= TAU { 0.0 } else { w };
+                        win[l] = rel[l] <= width;
+                        phi[l] = st + rel[l];
+                        s[l] = sth[l] * cpsi + cth[l] * spsi;
+                        co[l] = cth[l] * cpsi - sth[l] * spsi;
                     }
-                    let fs = &mut acc.force;
-                    add_to(row(fs, 0, stride, t), &dxy[0]);
-                    add_to(row(fs, 1, stride, t), &dxy[1]);
-                    let fz = row(fs, 2, stride, t);
+                    let mut h = [0.0; L];
+                    let mut gx = [0.0; L];
+                    let mut gy = [0.0; L];
+                    chip.eval(j, i, &phi, &s, &co, &mut h, &mut gx, &mut gy);
+                    let mut cut = [false; L];
+                    let mut edge = [false; L];
                     for l in 0..L {
-                        fz[l] -= f[2][l];
+                        cut[l] = win[l] && !(h[l] <= 0.0);
+                        edge[l] = if opts.edge_in_window { win[l] } else { cut[l] };
                     }
-                    add_to(row(fs, 3, stride, t), &f[3]);
-                    add_to(row(&mut acc.own, 2 * i, stride, t), &dxy[0]);
-                    add_to(row(&mut acc.own, 2 * i + 1, stride, t), &dxy[1]);
-                } else {
-                    let base = &mut acc.base;
-                    let mut v = [[0.0; L]; 16];
-                    let rows = if GENERAL { 16 } else { 6 };
-                    for l in 0..L {
-                        let (hc, ec) = (cut[l], edge[l]);
-                        let x = if GENERAL {
-                            let hz = h[l] * dz;
-                            [
-                                hz * co[l],
-                                hz * s[l],
-                                co[l] * db,
-                                s[l] * db,
-                                sk * hz,
-                                sk * db,
-                                sk * hz * co[l],
-                                sk * hz * s[l],
-                                sk * co[l] * db,
-                                sk * s[l] * db,
-                                ck * hz * co[l],
-                                ck * hz * s[l],
-                                ck * co[l] * db,
-                                ck * s[l] * db,
-                                ck * hz,
-                                ck * db,
-                            ]
-                        } else {
-                            let mut x = [0.0; 16];
-                            x[0] = h[l] * co[l] * dz;
-                            x[1] = h[l] * s[l] * dz;
-                            x[2] = co[l] * dz;
-                            x[3] = s[l] * dz;
-                            x[4] = h[l] * dz;
-                            x[5] = dz;
-                            x
-                        };
-                        for r in 0..rows {
-                            // edge rows 2, 3, 5, 8, 9, 12, 13, 15 follow the edge mask
-                            let on = if EDGE_ROW[r] { ec } else { hc };
-                            v[r][l] = if on { x[r] } else { 0.0 };
-                        }
-                    }
-                    for (r, vr) in v.iter().enumerate().take(rows) {
-                        add_to(row(base, r, stride, t), vr);
-                    }
-                    for p in 0..np {
-                        let (g, f) = match p {
-                            0 => (&gx, 1.0),
-                            1 => (&gy, 1.0),
-                            2 => (&gx, z),
-                            _ => (&gy, z),
-                        };
-                        let d = &mut acc.deriv;
-                        let r0 = p * drows;
-                        let mut w = [[0.0; L]; 8];
+                    // Each term below is the old loops' expression with the same association, masked
+                    // by a select (adding an exact 0 elsewhere): results are bit-identical to them.
+                    if SIM {
+                        let kc = &simc.kc;
+                        let mut f = [[0.0; L]; 4];
+                        let mut dxy = [[0.0; L]; 2];
                         for l in 0..L {
-                            let gh = if p < 2 { g[l] * dz } else { f * g[l] * dz };
-                            let x = [
-                                gh * co[l],
-                                gh * s[l],
-                                if GENERAL { sk * gh } else { gh },
-                                sk * gh * co[l],
-                                sk * gh * s[l],
-                                ck * gh * co[l],
-                                ck * gh * s[l],
-                                ck * gh,
-                            ];
-                            for r in 0..drows {
-                                w[r][l] = if cut[l] { x[r] } else { 0.0 };
+                            let (ft, frad, fax) = if GENERAL {
+                                let hz = h[l] * dz;
+                                let ft = kc.ktc * hz + kc.kte * db;
+                                let fr = kc.krc * hz + kc.kre * db;
+                                let fa = kc.kac * hz + kc.kae * db;
+                                (ft, fr * sk - fa * ck, fr * ck + fa * sk)
+                            } else {
+                                (
+                                    (kc.ktc * h[l] + kc.kte) * dz,
+                                    (kc.krc * h[l] + kc.kre) * dz,
+                                    (kc.kac * h[l] + kc.kae) * dz,
+                                )
+                            };
+                            let dx = ft * co[l] + frad * s[l];
+                            let dy = -ft * s[l] + frad * co[l];
+                            let on = cut[l];
+                            dxy[0][l] = if on { dx } else { 0.0 };
+                            dxy[1][l] = if on { dy } else { 0.0 };
+                            f[2][l] = if on { fax } else { 0.0 };
+                            f[3][l] = if on { ft * radius } else { 0.0 };
+                        }
+                        let fs = &mut acc.force;
+                        add_to(row(fs, 0, stride, t), &dxy[0]);
+                        add_to(row(fs, 1, stride, t), &dxy[1]);
+                        let fz = row(fs, 2, stride, t);
+                        for l in 0..L {
+                            fz[l] -= f[2][l];
+                        }
+                        add_to(row(fs, 3, stride, t), &f[3]);
+                        add_to(row(&mut acc.own, 2 * i, stride, t), &dxy[0]);
+                        add_to(row(&mut acc.own, 2 * i + 1, stride, t), &dxy[1]);
+                    } else {
+                        let base = &mut acc.base;
+                        let mut v = [[0.0; L]; 16];
+                        let rows = if GENERAL { 16 } else { 6 };
+                        for l in 0..L {
+                            let (hc, ec) = (cut[l], edge[l]);
+                            let x = if GENERAL {
+                                let hz = h[l] * dz;
+                                [
+                                    hz * co[l],
+                                    hz * s[l],
+                                    co[l] * db,
+                                    s[l] * db,
+                                    sk * hz,
+                                    sk * db,
+                                    sk * hz * co[l],
+                                    sk * hz * s[l],
+                                    sk * co[l] * db,
+                                    sk * s[l] * db,
+                                    ck * hz * co[l],
+                                    ck * hz * s[l],
+                                    ck * co[l] * db,
+                                    ck * s[l] * db,
+                                    ck * hz,
+                                    ck * db,
+                                ]
+                            } else {
+                                let mut x = [0.0; 16];
+                                x[0] = h[l] * co[l] * dz;
+                                x[1] = h[l] * s[l] * dz;
+                                x[2] = co[l] * dz;
+                                x[3] = s[l] * dz;
+                                x[4] = h[l] * dz;
+                                x[5] = dz;
+                                x
+                            };
+                            for r in 0..rows {
+                                // edge rows 2, 3, 5, 8, 9, 12, 13, 15 follow the edge mask
+                                let on = if EDGE_ROW[r] { ec } else { hc };
+                                v[r][l] = if on { x[r] } else { 0.0 };
                             }
                         }
-                        for (r, wr) in w.iter().enumerate().take(drows) {
-                            add_to(row(d, r0 + r, stride, t), wr);
+                        for (r, vr) in v.iter().enumerate().take(rows) {
+                            add_to(row(base, r, stride, t), vr);
+                        }
+                        for p in 0..np {
+                            let (g, f) = match p {
+                                0 => (&gx, 1.0),
+                                1 => (&gy, 1.0),
+                                2 => (&gx, z),
+                                _ => (&gy, z),
+                            };
+                            let d = &mut acc.deriv;
+                            let r0 = p * drows;
+                            let mut w = [[0.0; L]; 8];
+                            for l in 0..L {
+                                let gh = if p < 2 { g[l] * dz } else { f * g[l] * dz };
+                                let x = [
+                                    gh * co[l],
+                                    gh * s[l],
+                                    if GENERAL { sk * gh } else { gh },
+                                    sk * gh * co[l],
+                                    sk * gh * s[l],
+                                    ck * gh * co[l],
+                                    ck * gh * s[l],
+                                    ck * gh,
+                                ];
+                                for r in 0..drows {
+                                    w[r][l] = if cut[l] { x[r] } else { 0.0 };
+                                }
+                            }
+                            for (r, wr) in w.iter().enumerate().take(drows) {
+                                add_to(row(d, r0 + r, stride, t), wr);
+                            }
                         }
                     }
-                }
-                if SIM {
-                    let mut hn = [0.0; L];
-                    for l in 0..L {
-                        let hp = if h[l] > 0.0 { h[l] } else { 0.0 };
-                        hn[l] = if GENERAL { hp * sk } else { hp };
-                    }
-                    if j == 0 {
-                        let c = row(&mut acc.chip, i, stride, t);
+                    if SIM {
+                        let mut hn = [0.0; L];
                         for l in 0..L {
-                            c[l] = if win[l] { hn[l] } else { c[l] };
+                            let hp = if h[l] > 0.0 { h[l] } else { 0.0 };
+                            hn[l] = if GENERAL { hp * sk } else { hp };
+                        }
+                        if j == 0 {
+                            let c = row(&mut acc.chip, i, stride, t);
+                            for l in 0..L {
+                                c[l] = if win[l] { hn[l] } else { c[l] };
+                            }
+                        }
+                        let mc = &mut acc.max_chip[i];
+                        for l in 0..L {
+                            let v = if cut[l] { hn[l] } else { 0.0 };
+                            mc[l] = mc[l].max(v);
                         }
                     }
-                    let mc = &mut acc.max_chip[i];
-                    for l in 0..L {
-                        let v = if cut[l] { hn[l] } else { 0.0 };
-                        mc[l] = mc[l].max(v);
-                    }
+                    t += L;
                 }
-            });
+            }
         }
     }
+}
+
+/// One call of [`accumulate`] as a [`pulp::WithSimd`] operation: `with_simd` is inlined into
+/// pulp's `#[target_feature]` entry of the detected instruction set, and [`accumulate`] (always
+/// inlined) with it, so the lane loops compile to AVX-512 / AVX2 vectors (a plain closure is not
+/// inlined there and would run with the baseline SSE2 instructions).
+struct Job<'a, C, const GENERAL: bool, const SIM: bool> {
+    table: &'a EdgeTable,
+    chip: &'a C,
+    grid: &'a Grid,
+    disks: std::ops::Range<usize>,
+    opts: Options,
+    sim: Option<&'a SimConsts>,
+    acc: &'a mut Acc,
+}
+
+impl<C: LaneChip, const GENERAL: bool, const SIM: bool> pulp::WithSimd
+    for Job<'_, C, GENERAL, SIM>
+{
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        accumulate::<C, GENERAL, SIM>(
+            self.table, self.chip, self.grid, self.disks, self.opts, self.sim, self.acc,
+        )
+    }
+}
+
+/// [`accumulate`] with the SIMD instruction set detected at run time ([`pulp::Arch`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn dispatch<C: LaneChip, const GENERAL: bool, const SIM: bool>(
+    arch: pulp::Arch,
+    table: &EdgeTable,
+    chip: &C,
+    grid: &Grid,
+    disks: std::ops::Range<usize>,
+    opts: Options,
+    sim: Option<&SimConsts>,
+    acc: &mut Acc,
+) {
+    arch.dispatch(Job::<C, GENERAL, SIM> {
+        table,
+        chip,
+        grid,
+        disks,
+        opts,
+        sim,
+        acc,
+    })
 }

@@ -284,17 +284,16 @@ impl ForceModel {
                     edge_in_window: false,
                     np: 0,
                 };
-                arch.dispatch(|| {
-                    kernel::accumulate::<L, GENERAL, true>(
-                        table,
-                        lanes,
-                        &grid,
-                        0..table.len(),
-                        opts,
-                        Some(sim),
-                        &mut acc,
-                    )
-                });
+                kernel::dispatch::<L, GENERAL, true>(
+                    arch,
+                    table,
+                    lanes,
+                    &grid,
+                    0..table.len(),
+                    opts,
+                    Some(sim),
+                    &mut acc,
+                );
                 let stride = acc.stride;
                 let f = &acc.force;
                 for (t, o) in out.iter_mut().enumerate() {

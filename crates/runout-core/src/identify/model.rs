@@ -46,7 +46,7 @@ use crate::coefficients::CuttingCoefficients;
 use crate::cut::Cut;
 use crate::cutter::Cutter;
 use crate::edge::EdgeTable;
-use crate::force::kernel::{accumulate, padded, Acc, ArcGrad, ArcLanes, Grid, Options};
+use crate::force::kernel::{dispatch, padded, Acc, ArcGrad, ArcLanes, Grid, Options};
 use rayon::prelude::*;
 use std::f64::consts::TAU;
 
@@ -213,17 +213,16 @@ impl RevolutionModel {
         let stride = padded(n);
         let arch = pulp::Arch::new();
         let run = |mut acc: Acc, disks: std::ops::Range<usize>| {
-            arch.dispatch(|| {
-                accumulate::<ArcGrad, GENERAL, false>(
-                    &self.table,
-                    &lanes,
-                    &self.grid,
-                    disks,
-                    opts,
-                    None,
-                    &mut acc,
-                )
-            });
+            dispatch::<ArcGrad, GENERAL, false>(
+                arch,
+                &self.table,
+                &lanes,
+                &self.grid,
+                disks,
+                opts,
+                None,
+                &mut acc,
+            );
             acc
         };
         let empty = || Acc::new(stride, GENERAL, np, None);
