@@ -27,6 +27,10 @@
 //! which selects AVX-512 / AVX2+FMA / SSE code at run time (portable, stable Rust): the
 //! compiler turns each lane loop into one vector instruction of the selected width.
 
+// `!(h <= 0)` and `!(width < …)` are deliberate: they keep the scalar model's NaN semantics.
+// The lane functions take lane vectors by reference, many of them.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::too_many_arguments)]
+
 use crate::angle::wrap_tau;
 use crate::chip::ChipAtHeight;
 use crate::coefficients::CuttingCoefficients;
