@@ -1,8 +1,8 @@
 //! One per-disk edge geometry and engagement table for every force kernel (issue 12).
 //!
 //! Both [`crate::ForceModel::simulate`] and [`crate::identify::RevolutionModel`] consume an
-//! [`EdgeTable`]: a change of the cutter model (profile, lead angle, engagement) happens here
-//! and only here.
+//! [`EdgeTable`], through one shared kernel (`force::kernel`, issue 18): a change of the cutter
+//! model (profile, lead angle, engagement) happens here and only here.
 //!
 //! Discretisation (Engin & Altintas 2001, "Mechanics and dynamics of general milling cutters,
 //! Part I: helical end mills", Int. J. Mach. Tools Manuf. 41, §2–3; Lee & Altintas 1996,
