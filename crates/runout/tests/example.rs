@@ -122,3 +122,56 @@ fn shank_force_reports_progress_per_pass() {
     let b = example::run().unwrap();
     assert_eq!(runout::to_json(&a).unwrap(), runout::to_json(&b).unwrap());
 }
+
+/// Sources in memory give the report of the files (only the names differ), and progress comes
+/// as one stage per recording, named by it, begun and ended once.
+#[test]
+fn identify_reads_bytes_like_files_and_reports_progress() {
+    one_thread();
+    #[derive(Default)]
+    struct Log(Vec<String>);
+    impl runout::Progress for Log {
+        fn begin(&mut self, stage: &str, _total: Option<u64>) {
+            self.0.push(format!("begin {stage}"));
+        }
+        fn end(&mut self) {
+            self.0.push("end".into());
+        }
+    }
+    let from_files = identify_example::run().unwrap();
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/identify");
+    let mut req = runout::identify::RecordingsRequest::new(
+        Vec::new(),
+        runout::core::Cutter::flat(10.0, 4, 30.0).unwrap(),
+        Vec::new(),
+    );
+    for fz in [0.05, 0.08] {
+        let name = format!("cut_fz{fz}.txt");
+        let bytes = std::fs::read(format!("{dir}/{name}")).unwrap();
+        req.recordings.push(runout::Source::bytes(name, bytes));
+        req.cuts.push(
+            runout::core::Cut::new(3240.0, fz, 2.0)
+                .unwrap()
+                .radial(2.0, runout::core::MillingMode::Down, &req.cutter)
+                .unwrap(),
+        );
+    }
+    let mut log = Log::default();
+    let from_bytes = runout::identify::recordings(&req, &mut log).unwrap();
+    assert_eq!(
+        log.0,
+        ["begin cut_fz0.05.txt", "end", "begin cut_fz0.08.txt", "end"]
+    );
+    assert_eq!(from_bytes.recordings[1].file, "cut_fz0.08.txt");
+    let json = |r: &runout::identify::RecordingsReport| {
+        let mut v: serde_json::Value = serde_json::from_str(&runout::to_json(r).unwrap()).unwrap();
+        for rec in v["recordings"].as_array_mut().unwrap() {
+            rec["file"] = "-".into();
+        }
+        for rec in v["consistency"]["recordings"].as_array_mut().unwrap() {
+            rec["file"] = "-".into();
+        }
+        v
+    };
+    assert_eq!(json(&from_files), json(&from_bytes));
+}
