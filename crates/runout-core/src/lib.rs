@@ -27,6 +27,7 @@ pub mod cutter;
 pub mod displacement;
 pub mod edge;
 pub mod error;
+pub mod fit;
 pub mod force;
 pub mod grind;
 pub mod identify;

@@ -11,9 +11,9 @@
 //! Separating the edge terms from the shear term needs ≥ 2 distinct feeds.
 
 use super::error::IdentifyError;
-use super::lsq::{linear_lsq, r_squared};
-use super::multi_test::PeakTest;
+use super::peak_test::PeakTest;
 use super::sine_fit::Estimate;
+use crate::fit::{linear_lsq, r_squared};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::f64::consts::PI;

@@ -25,10 +25,10 @@
 //! [`IdentifyError::DegenerateTwoTeeth`].
 
 use super::error::IdentifyError;
-use super::lsq::{linear_lsq, r_squared};
 use crate::cut::Cut;
 use crate::cutter::Cutter;
 use crate::error::{positive, ParamError};
+use crate::fit::{linear_lsq, r_squared};
 use crate::force::ToothPeak;
 use crate::runout::seed::lambda_from_seed003_phase;
 use nalgebra::{DMatrix, DVector, Matrix3};
