@@ -184,20 +184,7 @@ pub enum SineHypothesis {
     ClosedPeriod,
 }
 
-/// A value with its standard error (`None` when it cannot be estimated).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Estimate {
-    /// The estimate.
-    pub value: f64,
-    /// Its standard error, if available.
-    pub se: Option<f64>,
-}
-
-impl Estimate {
-    fn new(value: f64, se: Option<f64>) -> Self {
-        Estimate { value, se }
-    }
-}
+pub use crate::estimate::Estimate;
 
 /// Where the standard errors of a sine fit come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
