@@ -53,9 +53,12 @@ fn case() -> (WaveformCase, ForceModel, ArcChip, Sampling) {
         v.iter().map(|x| x + n.sample(&mut rng)).collect()
     };
     let (x, y, z) = (noisy(&s.fx), noisy(&s.fy), noisy(&s.fz));
-    let waveform =
-        AveragedWaveform::average(0.0, 360, &[(Axis::X, &x), (Axis::Y, &y), (Axis::Z, &z)])
-            .unwrap();
+    let waveform = AveragedWaveform::average(
+        0.0,
+        360,
+        &[(FrameAxis::X, &x), (FrameAxis::Y, &y), (FrameAxis::Z, &z)],
+    )
+    .unwrap();
     (
         WaveformCase {
             cutter,
@@ -145,7 +148,7 @@ fn chain_cases() -> Vec<WaveformCase> {
             );
             let mut rng = StdRng::seed_from_u64(11 + i as u64);
             let white = Normal::new(0.0, 1.0).unwrap();
-            let mut channel = |v: &[f64], axis: Axis| -> Vec<f64> {
+            let mut channel = |v: &[f64], axis: FrameAxis| -> Vec<f64> {
                 let kept: Vec<f64> = chain
                     .axis(axis)
                     .filter(12_000.0 * OVERSAMPLE as f64, v)
@@ -163,12 +166,16 @@ fn chain_cases() -> Vec<WaveformCase> {
                     })
                     .collect()
             };
-            let (fx, fy) = (channel(&s.fx, Axis::X), channel(&s.fy, Axis::Y));
+            let (fx, fy) = (channel(&s.fx, FrameAxis::X), channel(&s.fy, FrameAxis::Y));
             WaveformCase {
                 cutter: cutter.clone(),
                 cut,
-                waveform: AveragedWaveform::average(0.0, n, &[(Axis::X, &fx), (Axis::Y, &fy)])
-                    .unwrap(),
+                waveform: AveragedWaveform::average(
+                    0.0,
+                    n,
+                    &[(FrameAxis::X, &fx), (FrameAxis::Y, &fy)],
+                )
+                .unwrap(),
             }
         })
         .collect()
@@ -179,7 +186,7 @@ fn bench_chain(c: &mut Criterion) {
     let fitted = FullSignalOptions {
         chain: Some(ChainOptions {
             model: ChainModel::FitModes {
-                axes: vec![(Axis::X, None), (Axis::Y, None)],
+                axes: vec![(FrameAxis::X, None), (FrameAxis::Y, None)],
                 fit_gain: false,
             },
             spindle_hz: vec![125.0; 5],

@@ -12,7 +12,7 @@
 use proptest::prelude::*;
 use runout_core::edge::EdgeTable;
 use runout_core::identify::{
-    calibrate_mean_forces_general, force_from_basis, Axis, MeanForceDesign, MeanForces,
+    calibrate_mean_forces_general, force_from_basis, FrameAxis, MeanForceDesign, MeanForces,
     RevolutionModel,
 };
 use runout_core::*;
@@ -297,7 +297,11 @@ fn revolution_model_equals_simulation_for_every_profile() {
         let s = m.simulate(&chip, &samp);
         let rev = RevolutionModel::new(&c, &m.cut, 0.0, 360, disks);
         let sums = rev.sums(runout.vector_at(0.0), [0.0; 2], false);
-        for (axis, sim) in [(Axis::X, &s.fx), (Axis::Y, &s.fy), (Axis::Z, &s.fz)] {
+        for (axis, sim) in [
+            (FrameAxis::X, &s.fx),
+            (FrameAxis::Y, &s.fy),
+            (FrameAxis::Z, &s.fz),
+        ] {
             let scale = sim.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             assert!(scale > 1.0, "{p:?}: no force");
             for (q, b) in sums.base.iter().enumerate() {
@@ -585,9 +589,16 @@ fn ball_round_trip_on_a_synchronous_grid() {
             v.iter().map(|x| x + noise.sample(&mut rng)).collect()
         };
         let (fx, fy, fzz) = (noisy(&s.fx), noisy(&s.fy), noisy(&s.fz));
-        let waveform =
-            AveragedWaveform::average(0.0, 360, &[(Axis::X, &fx), (Axis::Y, &fy), (Axis::Z, &fzz)])
-                .unwrap();
+        let waveform = AveragedWaveform::average(
+            0.0,
+            360,
+            &[
+                (FrameAxis::X, &fx),
+                (FrameAxis::Y, &fy),
+                (FrameAxis::Z, &fzz),
+            ],
+        )
+        .unwrap();
         cases.push(WaveformCase {
             cutter: c.clone(),
             cut: m.cut,

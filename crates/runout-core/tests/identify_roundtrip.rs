@@ -76,9 +76,16 @@ fn recording(
         v.iter().map(|x| x + noise.sample(&mut rng)).collect()
     };
     let (fx, fy, fz_) = (noisy(&series.fx), noisy(&series.fy), noisy(&series.fz));
-    let waveform =
-        AveragedWaveform::average(0.0, 360, &[(Axis::X, &fx), (Axis::Y, &fy), (Axis::Z, &fz_)])
-            .unwrap();
+    let waveform = AveragedWaveform::average(
+        0.0,
+        360,
+        &[
+            (FrameAxis::X, &fx),
+            (FrameAxis::Y, &fy),
+            (FrameAxis::Z, &fz_),
+        ],
+    )
+    .unwrap();
     assert_eq!(waveform.revolutions, 20);
     (
         WaveformCase {
@@ -481,9 +488,12 @@ fn tilt_round_trip() {
         v.iter().map(|x| x + n.sample(&mut rng)).collect()
     };
     let (x, y, z) = (noisy(&s.fx), noisy(&s.fy), noisy(&s.fz));
-    let waveform =
-        AveragedWaveform::average(0.0, 360, &[(Axis::X, &x), (Axis::Y, &y), (Axis::Z, &z)])
-            .unwrap();
+    let waveform = AveragedWaveform::average(
+        0.0,
+        360,
+        &[(FrameAxis::X, &x), (FrameAxis::Y, &y), (FrameAxis::Z, &z)],
+    )
+    .unwrap();
     let fit = full_signal_fit(
         &[WaveformCase {
             cutter,

@@ -240,7 +240,7 @@ pub fn read_cases(path: &Path) -> Result<Vec<ChipCase>, ChipConfigError> {
     let file = path.display().to_string();
     let text = crate::textfile::read_text(path).map_err(|e| ChipConfigError::Parse {
         file: file.clone(),
-        message: match e.line {
+        message: match e.line() {
             Some(l) => format!("line {l}: {}", e.message),
             None => e.message,
         },
