@@ -131,6 +131,19 @@ fn simulate() {
     ));
 }
 
+#[test]
+fn inspect() {
+    let d = tmp();
+    insta::assert_snapshot!(run(
+        &[
+            "inspect",
+            "--json",
+            "crates/runout-io/tests/fixtures/tdms_writer.tdms"
+        ],
+        d.path()
+    ));
+}
+
 /// `chip compare` measures throughput on the wall clock: that one object is redacted.
 fn without_throughput(text: &str) -> String {
     let mut out = String::new();

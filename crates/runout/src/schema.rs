@@ -31,5 +31,7 @@ pub fn all() -> Vec<(&'static str, String, String)> {
         one::<crate::chip::EvalReport>(),
         one::<crate::grind::CompensateReport>(),
         one::<crate::grind::CheckReport>(),
+        one::<crate::simulate::SimulateReport>(),
+        one::<crate::inspect::InspectReport>(),
     ]
 }
