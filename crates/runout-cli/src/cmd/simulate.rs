@@ -1,5 +1,6 @@
 //! `runout simulate CONFIG.toml [flags]`: mechanistic force simulation with runout.
 
+use crate::flags::{config_file, PlotFlags};
 use crate::output;
 use anyhow::{Context, Result};
 use runout::simulate::{render, simulate, RecordingOptions, SimulateRequest};
@@ -12,7 +13,7 @@ use std::path::{Path, PathBuf};
 /// Values may carry a unit suffix of the right quantity (`--runout-um 0.008mm`, `--diameter-mm 10mm`).
 #[derive(clap::Args, Debug, Default)]
 pub struct CaseFlags {
-    /// Number of teeth K.
+    /// Number of teeth K (count).
     #[arg(long, allow_hyphen_values = true)]
     pub teeth: Option<String>,
     /// Cutter diameter D (mm).
@@ -96,8 +97,12 @@ pub struct CaseFlags {
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// Case file (TOML) with the keys of the flags below (e.g. `diameter_mm = 10`). Optional: a
-    /// case can be given by flags alone.
+    /// case can be given by flags alone. Same as --config FILE.
+    #[arg(value_name = "CONFIG")]
     pub config: Option<PathBuf>,
+    /// Case file (TOML), as the positional CONFIG.
+    #[arg(long = "config", value_name = "FILE")]
+    pub config_flag: Option<PathBuf>,
     #[command(flatten)]
     pub case: CaseFlags,
     /// Spindle revolutions to simulate (count).
@@ -118,9 +123,9 @@ pub struct Args {
     /// Write the JSON summary (inputs, per-tooth peaks, mean forces); `-` for stdout.
     #[arg(long)]
     pub json: Option<PathBuf>,
-    /// Plot forces vs spindle angle with each tooth's peak marked (.svg or .png).
-    #[arg(long)]
-    pub plot: Option<PathBuf>,
+    /// Plots: forces vs spindle angle with each tooth's peak marked (`forces.<format>`).
+    #[command(flatten)]
+    pub plots: PlotFlags,
     #[command(flatten)]
     pub recording: RecordingFlags,
     #[command(flatten)]
@@ -220,7 +225,7 @@ pub fn run(a: Args) -> Result<()> {
         ("disks", &a.disks),
         ("chip_model", &a.chip_model),
     ]);
-    let config = a.config.as_ref().map(Source::path);
+    let config = config_file(&a.config, &a.config_flag)?.map(Source::path);
     let mut req = SimulateRequest::from_config(config.as_ref(), flags)?;
     req.sensor = a.sensor.request()?;
     let r = &a.recording;
@@ -241,12 +246,8 @@ pub fn run(a: Args) -> Result<()> {
         });
     }
     let inputs: Vec<&Path> = req.inputs.iter().map(|p| p.as_path()).collect();
-    for out in [&a.out, &a.json, &a.plot, &r.recording]
-        .into_iter()
-        .flatten()
-    {
-        output::check_not_input(out, &inputs)?;
-    }
+    let plot = a.plots.file("forces");
+    crate::flags::check_outputs([&a.out, &a.json, &plot, &r.recording], &inputs)?;
     let report = simulate(&req)?;
     if let Some(out) = &a.out {
         render::forces_csv(output::create(out)?, &report)?;
@@ -266,7 +267,8 @@ pub fn run(a: Args) -> Result<()> {
     if let Some(j) = &a.json {
         output::write_text(j, &runout::to_json(&report)?)?;
     }
-    if let Some(p) = &a.plot {
+    if let Some(p) = &plot {
+        a.plots.create_dir()?;
         render::plot(p, &report)?;
     }
     let to_stdout = |p: &Option<PathBuf>| p.as_deref() == Some(Path::new("-"));

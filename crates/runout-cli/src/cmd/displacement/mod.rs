@@ -7,6 +7,7 @@ mod heights;
 mod signal;
 mod teeth;
 
+use crate::flags::choice;
 use anyhow::{bail, Context, Result};
 use runout::displacement::Sensor;
 use runout_core::displacement::{BeamGeometry, SensorSign};
@@ -50,18 +51,17 @@ pub struct OutputFlags {
     /// Write the human-readable report here instead of stdout (`-` = stdout).
     #[arg(long, allow_hyphen_values = true)]
     pub text: Option<PathBuf>,
-    /// Plot (.svg or .png).
-    #[arg(long, allow_hyphen_values = true)]
-    pub plot: Option<PathBuf>,
+    /// Plot (`teeth`, `heights` or `signal`.<format>).
+    #[command(flatten)]
+    pub plots: crate::flags::PlotFlags,
 }
 
 impl OutputFlags {
-    /// Refuse outputs that overwrite `input`.
-    pub fn check(&self, input: &Path) -> Result<()> {
-        for out in [&self.json, &self.text, &self.plot].into_iter().flatten() {
-            crate::output::check_not_input(out, &[input])?;
-        }
-        Ok(())
+    /// Refuse outputs that overwrite `input`; the plot file of `kind`.
+    pub fn check(&self, input: &Path, kind: &str) -> Result<Option<PathBuf>> {
+        let plot = self.plots.file(kind);
+        crate::flags::check_outputs([&self.json, &self.text, &plot], &[input])?;
+        Ok(plot)
     }
 
     /// Write JSON and text (text to stdout unless the JSON goes there).
@@ -105,18 +105,32 @@ pub fn count(flag: &str, v: &Option<String>) -> Result<Option<usize>> {
 }
 
 /// `--sensor distance|radial`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum SignArg {
+    /// The reading grows away from the tool (triangulation lasers).
+    Distance,
+    /// The reading grows with the radius.
+    Radial,
+}
+
+/// `--sensor distance|radial` (default distance).
 pub fn sensor_sign(v: &Option<String>) -> Result<SensorSign> {
-    match v.as_deref().map(str::trim) {
-        None | Some("distance") => Ok(SensorSign::Distance),
-        Some("radial") => Ok(SensorSign::Radial),
-        Some(o) => bail!("--sensor: `{o}` is not `distance` (reading grows away from the tool) or `radial` (reading grows with the radius)"),
-    }
+    Ok(
+        match v
+            .as_deref()
+            .map(|t| choice::<SignArg>("--sensor", t))
+            .transpose()?
+        {
+            None | Some(SignArg::Distance) => SensorSign::Distance,
+            Some(SignArg::Radial) => SensorSign::Radial,
+        },
+    )
 }
 
 /// Cutter flags shared by teeth and signal.
 #[derive(clap::Args, Debug, Default)]
 pub struct CutterFlags {
-    /// Number of teeth K.
+    /// Number of teeth K (count).
     #[arg(long, allow_hyphen_values = true)]
     pub teeth: Option<String>,
     /// Nominal cutter diameter D (mm).
