@@ -65,6 +65,68 @@ impl PlotFlags {
     }
 }
 
+/// The cutter: one set of flags for every command that takes one (issue 13 item 7), the keys
+/// of a case file (`teeth`, `diameter_mm`, …), resolved by one resolver
+/// ([`runout_io::config::simulate::resolve_cutter`]). Values may carry a unit suffix.
+#[derive(clap::Args, Debug, Default, Clone)]
+pub struct CutterFlags {
+    /// Number of teeth K (count).
+    #[arg(long, allow_hyphen_values = true)]
+    pub teeth: Option<String>,
+    /// Cutter diameter D (mm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub diameter_mm: Option<String>,
+    /// Helix angle (deg); 0 for straight flutes.
+    #[arg(long, allow_hyphen_values = true)]
+    pub helix_deg: Option<String>,
+    /// Variable pitch angles (deg), K comma-separated values summing to 360.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pitch_deg: Option<String>,
+    /// Flute length (mm).
+    #[arg(long, allow_hyphen_values = true)]
+    pub flute_length_mm: Option<String>,
+    /// End profile: flat | ball | bull_nose | tapered (default flat).
+    #[arg(long, allow_hyphen_values = true)]
+    pub profile: Option<String>,
+    /// Corner radius r_c of a bull_nose cutter (mm), 0 < r_c <= D/2.
+    #[arg(long, allow_hyphen_values = true)]
+    pub corner_radius_mm: Option<String>,
+    /// Taper (half-cone) angle of a tapered cutter (deg), 0 < α < 45; D is the tip diameter.
+    #[arg(long, allow_hyphen_values = true)]
+    pub taper_deg: Option<String>,
+    /// Flute winding on a ball, bull-nose or taper: constant_lead | constant_helix (default constant_lead).
+    #[arg(long, allow_hyphen_values = true)]
+    pub flute_lead: Option<String>,
+}
+
+impl CutterFlags {
+    /// The flags as (case-file key, value given).
+    pub fn pairs(&self) -> [(&'static str, &Option<String>); 9] {
+        [
+            ("teeth", &self.teeth),
+            ("diameter_mm", &self.diameter_mm),
+            ("helix_deg", &self.helix_deg),
+            ("pitch_deg", &self.pitch_deg),
+            ("flute_length_mm", &self.flute_length_mm),
+            ("profile", &self.profile),
+            ("corner_radius_mm", &self.corner_radius_mm),
+            ("taper_deg", &self.taper_deg),
+            ("flute_lead", &self.flute_lead),
+        ]
+    }
+
+    /// The cutter, when --teeth and --diameter-mm are given (`None` when neither is).
+    pub fn cutter(&self) -> Result<Option<runout_core::Cutter>> {
+        match (&self.teeth, &self.diameter_mm) {
+            (Some(_), Some(_)) => {}
+            (None, None) => return Ok(None),
+            _ => bail!("--teeth and --diameter-mm go together"),
+        }
+        let s = runout::case::settings(None, runout::case::flag_layer(self.pairs()), &[])?;
+        Ok(Some(runout_io::config::simulate::resolve_cutter(&s)?))
+    }
+}
+
 /// The case file: the positional argument or `--config FILE` (one of them).
 pub fn config_file(
     positional: &Option<PathBuf>,

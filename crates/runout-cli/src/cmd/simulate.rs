@@ -1,6 +1,6 @@
 //! `runout simulate CONFIG.toml [flags]`: mechanistic force simulation with runout.
 
-use crate::flags::{config_file, PlotFlags};
+use crate::flags::{config_file, CutterFlags, PlotFlags};
 use crate::output;
 use anyhow::{Context, Result};
 use runout::simulate::{render, simulate, RecordingOptions, SimulateRequest};
@@ -13,33 +13,8 @@ use std::path::{Path, PathBuf};
 /// Values may carry a unit suffix of the right quantity (`--runout-um 0.008mm`, `--diameter-mm 10mm`).
 #[derive(clap::Args, Debug, Default)]
 pub struct CaseFlags {
-    /// Number of teeth K (count).
-    #[arg(long, allow_hyphen_values = true)]
-    pub teeth: Option<String>,
-    /// Cutter diameter D (mm).
-    #[arg(long, allow_hyphen_values = true)]
-    pub diameter_mm: Option<String>,
-    /// Helix angle (deg); 0 for straight flutes.
-    #[arg(long, allow_hyphen_values = true)]
-    pub helix_deg: Option<String>,
-    /// Variable pitch angles (deg), K comma-separated values summing to 360.
-    #[arg(long, allow_hyphen_values = true)]
-    pub pitch_deg: Option<String>,
-    /// Flute length (mm).
-    #[arg(long, allow_hyphen_values = true)]
-    pub flute_length_mm: Option<String>,
-    /// End profile: flat | ball | bull_nose | tapered (default flat).
-    #[arg(long, allow_hyphen_values = true)]
-    pub profile: Option<String>,
-    /// Corner radius r_c of a bull_nose cutter (mm), 0 < r_c <= D/2.
-    #[arg(long, allow_hyphen_values = true)]
-    pub corner_radius_mm: Option<String>,
-    /// Taper (half-cone) angle of a tapered cutter (deg), 0 < α < 45; D is the tip diameter.
-    #[arg(long, allow_hyphen_values = true)]
-    pub taper_deg: Option<String>,
-    /// Flute winding on a ball, bull-nose or taper: constant_lead | constant_helix (default constant_lead).
-    #[arg(long, allow_hyphen_values = true)]
-    pub flute_lead: Option<String>,
+    #[command(flatten)]
+    pub cutter: CutterFlags,
     /// Spindle speed (rpm).
     #[arg(long, allow_hyphen_values = true)]
     pub rpm: Option<String>,
@@ -182,16 +157,7 @@ impl CaseFlags {
     /// The flags that were given (and `extra` ones), as a settings layer.
     pub fn layer(&self, extra: &[(&str, &Option<String>)]) -> Layer {
         let c = self;
-        let pairs: [(&str, &Option<String>); 26] = [
-            ("teeth", &c.teeth),
-            ("diameter_mm", &c.diameter_mm),
-            ("helix_deg", &c.helix_deg),
-            ("pitch_deg", &c.pitch_deg),
-            ("flute_length_mm", &c.flute_length_mm),
-            ("profile", &c.profile),
-            ("corner_radius_mm", &c.corner_radius_mm),
-            ("taper_deg", &c.taper_deg),
-            ("flute_lead", &c.flute_lead),
+        let pairs: [(&str, &Option<String>); 17] = [
             ("rpm", &c.rpm),
             ("fz_mm", &c.fz_mm),
             ("ap_mm", &c.ap_mm),
@@ -210,7 +176,13 @@ impl CaseFlags {
             ("kre", &c.kre),
             ("kae", &c.kae),
         ];
-        runout::case::flag_layer(pairs.into_iter().chain(extra.iter().copied()))
+        runout::case::flag_layer(
+            c.cutter
+                .pairs()
+                .into_iter()
+                .chain(pairs)
+                .chain(extra.iter().copied()),
+        )
     }
 }
 

@@ -18,7 +18,9 @@ use runout_core::{
     tooth_peaks, ArcChip, EquivalentChip, ExactChip, ForceModel, ForceSeries, RadiusProfile,
     Sampling, ToothPeak,
 };
-use runout_io::config::simulate::{resolve_simulate, simulate_key_names, SimulateCase};
+use runout_io::config::simulate::{
+    resolve_simulate, simulate_key_names, ForceChipModel, SimulateCase,
+};
 use runout_io::config::Layer;
 use schemars::JsonSchema;
 use serde::Serialize;
@@ -187,13 +189,13 @@ fn simulate_series(case: &SimulateCase) -> Result<ForceSeries> {
         coefficients: case.coefficients,
     };
     let (c, r, fz) = (&case.cutter, &case.runout, case.cut.fz());
-    Ok(match case.chip_model.as_str() {
-        "exact" => model.simulate(&ExactChip::new(c, r, fz)?, &case.sampling),
-        "equivalent" => model.simulate(
+    Ok(match case.chip_model {
+        ForceChipModel::Exact => model.simulate(&ExactChip::new(c, r, fz)?, &case.sampling),
+        ForceChipModel::Equivalent => model.simulate(
             &EquivalentChip::new(c, r, fz, EquivalentParams::default())?,
             &case.sampling,
         ),
-        _ => model.simulate(&ArcChip::new(c, r, fz)?, &case.sampling),
+        ForceChipModel::Arc => model.simulate(&ArcChip::new(c, r, fz)?, &case.sampling),
     })
 }
 
@@ -270,7 +272,7 @@ fn report(
         revolutions: case.sampling.revolutions,
         step_deg: case.sampling.step.to_degrees(),
         disks: case.sampling.disks,
-        chip_model: case.chip_model.clone(),
+        chip_model: case.chip_model.name().into(),
     };
     SimulateReport {
         schema: SimulateReport::SCHEMA.into(),

@@ -91,19 +91,6 @@ pub fn um_as_mm(flag: &str, v: &Option<String>) -> Result<Option<f64>> {
     Ok(quantity(flag, v, Quantity::LengthUm)?.map(|x| x * 1e-3))
 }
 
-/// A count flag (integer ≥ 1).
-pub fn count(flag: &str, v: &Option<String>) -> Result<Option<usize>> {
-    v.as_deref()
-        .map(|t| {
-            t.trim()
-                .parse::<usize>()
-                .ok()
-                .filter(|n| *n >= 1)
-                .with_context(|| format!("--{flag}: `{t}` is not an integer >= 1"))
-        })
-        .transpose()
-}
-
 /// `--sensor distance|radial`.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 enum SignArg {
@@ -127,18 +114,12 @@ pub fn sensor_sign(v: &Option<String>) -> Result<SensorSign> {
     )
 }
 
-/// Cutter flags shared by teeth and signal.
+/// Cutter flags shared by teeth and signal: the cutter (the flags of every command) and where
+/// it is read.
 #[derive(clap::Args, Debug, Default)]
 pub struct CutterFlags {
-    /// Number of teeth K (count).
-    #[arg(long, allow_hyphen_values = true)]
-    pub teeth: Option<String>,
-    /// Nominal cutter diameter D (mm).
-    #[arg(long, allow_hyphen_values = true)]
-    pub diameter_mm: Option<String>,
-    /// Helix angle (deg), 0 for straight flutes.
-    #[arg(long, allow_hyphen_values = true)]
-    pub helix_deg: Option<String>,
+    #[command(flatten)]
+    pub cutter: crate::flags::CutterFlags,
     /// Height z of the readings above the tool tip (mm); tooth angles follow the helix.
     #[arg(long, allow_hyphen_values = true)]
     pub height_mm: Option<String>,
@@ -153,14 +134,7 @@ pub struct CutterFlags {
 impl CutterFlags {
     /// The cutter, when --teeth and --diameter-mm are given.
     pub fn cutter(&self) -> Result<Option<Cutter>> {
-        let k = count("teeth", &self.teeth)?;
-        let d = quantity("diameter-mm", &self.diameter_mm, Quantity::LengthMm)?;
-        let helix = quantity("helix-deg", &self.helix_deg, Quantity::AngleDeg)?.unwrap_or(0.0);
-        match (k, d) {
-            (Some(k), Some(d)) => Ok(Some(Cutter::flat(d, k, helix)?)),
-            (None, None) => Ok(None),
-            _ => bail!("--teeth and --diameter-mm go together"),
-        }
+        self.cutter.cutter()
     }
     /// Height (mm), default 0.
     pub fn height(&self) -> Result<f64> {
