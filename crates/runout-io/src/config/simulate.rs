@@ -213,7 +213,7 @@ pub fn resolve_cutter(s: &Settings) -> Result<Cutter, ConfigError> {
         None => Cutter::new(
             d,
             vec![std::f64::consts::TAU / teeth as f64; teeth],
-            helix,
+            helix.to_radians(),
             flute,
             profile.clone(),
         ),
@@ -231,7 +231,7 @@ pub fn resolve_cutter(s: &Settings) -> Result<Cutter, ConfigError> {
             Cutter::new(
                 d,
                 p.iter().map(|x| x.to_radians()).collect(),
-                helix,
+                helix.to_radians(),
                 flute,
                 profile,
             )
