@@ -27,7 +27,7 @@ fn case_with(profile: RadiusProfile) -> (ForceModel, ArcChip, Sampling) {
     let cutter = Cutter::new(
         10.0,
         vec![std::f64::consts::TAU / 4.0; 4],
-        30.0,
+        30.0f64.to_radians(),
         f64::INFINITY,
         profile,
     )

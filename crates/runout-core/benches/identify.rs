@@ -29,7 +29,7 @@ use runout_core::*;
 /// K 4, D 10, helix 30°, down-milling a_e 3, a_p 2, f_z 0.08, ρ 8 µm at 30°; 20 revolutions at
 /// 1°, 2 % noise, averaged → one revolution of F_x, F_y, F_z (360 samples each).
 fn case() -> (WaveformCase, ForceModel, ArcChip, Sampling) {
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.008, 30f64.to_radians()).unwrap();
     let cut = Cut::new(3000.0, 0.08, 2.0)
         .unwrap()
@@ -114,7 +114,7 @@ fn chain_cases() -> Vec<WaveformCase> {
         y: AxisChain::Modes(vec![mode]),
         z: AxisChain::Rigid,
     };
-    let cutter = Cutter::flat(20.0, 2, 40.0).unwrap();
+    let cutter = Cutter::flat(20.0, 2, 40.0f64.to_radians()).unwrap();
     let n = 96; // 12 kHz at 7500 rpm
     let lag_deg = (4.0 * 40f64.to_radians().tan() / 10.0).to_degrees();
     let disks = (lag_deg / 0.05).ceil() as usize;

@@ -10,7 +10,7 @@
 //!
 //! ```
 //! use runout_core::*;
-//! let cutter = Cutter::flat(10.0, 4, 30.0)?;
+//! let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians())?;
 //! let runout = Runout::new(0.008, 0.0)?;
 //! let r0 = runout.tooth_radius(&cutter, 0, 0.0);
 //! assert!((r0 - 5.008).abs() < 1e-9);

@@ -32,7 +32,14 @@ fn profiles() -> Vec<RadiusProfile> {
 }
 
 fn cutter(d: f64, k: usize, helix: f64, p: RadiusProfile) -> Cutter {
-    Cutter::new(d, vec![TAU / k as f64; k], helix, f64::INFINITY, p).unwrap()
+    Cutter::new(
+        d,
+        vec![TAU / k as f64; k],
+        helix.to_radians(),
+        f64::INFINITY,
+        p,
+    )
+    .unwrap()
 }
 
 fn model(
@@ -153,7 +160,7 @@ fn flat_end_through_the_general_kernel_equals_the_cylindrical_model() {
     ];
     let mut worst = 0.0f64;
     for (k, helix, runout, mode, ae, disks) in cases {
-        let c = Cutter::flat(10.0, k, helix).unwrap();
+        let c = Cutter::flat(10.0, k, f64::to_radians(helix)).unwrap();
         let (m, chip) = model(&c, runout, 0.06, 2.0, ae, mode, coef());
         let samp = Sampling::new(1.0, 0.7, disks).unwrap();
         let a = m.simulate(&chip, &samp);
@@ -472,7 +479,7 @@ fn ball_engagement_per_disk() {
     // a_e/R(z) > a_e/R.
     let top = t.disk(199).width.to_degrees();
     assert!((top - 27.9).abs() < 0.2, "{top}");
-    let flat = cut.immersion(&Cutter::flat(6.0, 3, 30.0).unwrap());
+    let flat = cut.immersion(&Cutter::flat(6.0, 3, 30.0f64.to_radians()).unwrap());
     assert!((flat.1.to_degrees() - 16.6).abs() < 0.1);
 }
 

@@ -75,7 +75,7 @@ fn four_flute() -> Setup {
 const FEEDS: [f64; 5] = [0.04, 0.06, 0.08, 0.10, 0.12];
 
 fn cutter_cut(s: &Setup, fz: f64) -> (Cutter, Cut) {
-    let cutter = Cutter::flat(s.diameter, s.teeth, s.helix_deg).unwrap();
+    let cutter = Cutter::flat(s.diameter, s.teeth, s.helix_deg.to_radians()).unwrap();
     let cut = Cut::new(s.rpm, fz, s.ap)
         .unwrap()
         .radial(s.ae, s.mode, &cutter)

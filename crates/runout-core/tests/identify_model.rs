@@ -41,7 +41,7 @@ fn compare(cutter: Cutter, runout: Runout, cut: Cut, disks: usize) {
 
 #[test]
 fn revolution_model_matches_simulation() {
-    let c4 = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let c4 = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let r = Runout::new(0.012, 0.7).unwrap();
     let up = Cut::new(3000.0, 0.08, 2.0)
         .unwrap()
@@ -82,7 +82,7 @@ fn revolution_model_matches_simulation() {
 
 #[test]
 fn runout_derivatives_match_finite_differences() {
-    let c = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let c = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let cut = Cut::new(3000.0, 0.08, 2.0)
         .unwrap()
         .radial(4.0, MillingMode::Down, &c)
@@ -169,7 +169,7 @@ fn frequency_estimate_exact_on_linear_chip_model() {
         (2, 30.0, 0.008, 40.0),
         (3, 30.0, 0.005, -150.0),
     ] {
-        let c = Cutter::flat(10.0, k, helix).unwrap();
+        let c = Cutter::flat(10.0, k, f64::to_radians(helix)).unwrap();
         let r = Runout::new(rho, f64::to_radians(lam)).unwrap();
         let cut = Cut::new(3240.0, 0.1, 1.0)
             .unwrap()

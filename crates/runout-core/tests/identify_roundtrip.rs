@@ -61,7 +61,7 @@ fn recording(
     kc: CuttingCoefficients,
     seed: u64,
 ) -> (WaveformCase, ForceSeries) {
-    let cutter = Cutter::flat(10.0, s.teeth, s.helix_deg).unwrap();
+    let cutter = Cutter::flat(10.0, s.teeth, s.helix_deg.to_radians()).unwrap();
     let (model, chip) = force_model(s, cutter.clone(), fz, kc);
     let cut = model.cut;
     // the "truth" uses finer disks (helix lag 0.05° per disk) than the identification model's
@@ -464,7 +464,7 @@ fn two_teeth_straight_flutes_offset_across_the_tooth_line_is_below_the_noise_bou
 fn tilt_round_trip() {
     // offset 6 µm at 40° plus tilt 2 µm/mm at −60° over a_p 4 mm (helix 30°, K 4, down a_e 3):
     // fitted with the tilt vector; both recovered (offset within 0.3 µm, tilt within 0.2 µm/mm).
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.006, 40f64.to_radians())
         .unwrap()
         .with_tilt(0.002, -60f64.to_radians())

@@ -60,7 +60,7 @@ impl Synthetic {
 /// 3 teeth, D10, helix 30°, ρ = 10 µm at λ = 40°, down milling a_e 3 mm, a_p 2 mm, f_z 0.06 mm;
 /// true speed `true_rpm` (nominal 6000), 2 % white noise (of the peak |F_xy|) on every channel.
 fn synthetic(true_rpm: f64, seed: u64) -> Synthetic {
-    let cutter = Cutter::flat(10.0, 3, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 3, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.010, 40f64.to_radians()).unwrap();
     let cut = Cut::new(true_rpm, 0.06, 2.0)
         .unwrap()

@@ -65,7 +65,7 @@ fn harmonic(v: &[f64], k: usize) -> (f64, f64) {
 /// ```
 /// use runout_core::*;
 /// use runout_core::identify::{harmonic_start_angle, AveragedWaveform, FrameAxis, WaveformCase};
-/// let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+/// let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
 /// let cut = Cut::new(3000.0, 0.08, 2.0).unwrap().radial(2.0, MillingMode::Down, &cutter).unwrap();
 /// let kc = CuttingCoefficients::new([2000.0, 800.0, 300.0], [60.0, 100.0, 0.0]).unwrap();
 /// let m = ForceModel { cutter: cutter.clone(), runout: Runout::none(), cut, coefficients: kc };

@@ -281,8 +281,14 @@ fn cutter_of(s: &ChipCaseSpec) -> Result<Cutter, String> {
             vec![TAU / s.teeth as f64; s.teeth]
         }
     };
-    Cutter::new(s.diameter_mm, pitch, s.helix_deg, f64::INFINITY, profile)
-        .map_err(|e| e.to_string())
+    Cutter::new(
+        s.diameter_mm,
+        pitch,
+        s.helix_deg.to_radians(),
+        f64::INFINITY,
+        profile,
+    )
+    .map_err(|e| e.to_string())
 }
 
 fn runout_of(s: &ChipCaseSpec, cutter: &Cutter) -> Result<Runout, String> {
