@@ -53,7 +53,7 @@ fn case_with(profile: RadiusProfile) -> (ForceModel, ArcChip, Sampling) {
 }
 
 fn numpy_case() -> (ForceModel, ArcChip, Sampling) {
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30f64.to_radians()).unwrap();
     let runout = Runout::new(0.008, 0.0).unwrap();
     let cut = Cut::new(3240.0, 0.08, 1.0)
         .unwrap()

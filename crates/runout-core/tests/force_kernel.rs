@@ -50,17 +50,17 @@ fn same(a: &ForceSeries, b: &ForceSeries) {
 fn cutters() -> Vec<Cutter> {
     let tau = std::f64::consts::TAU;
     vec![
-        Cutter::flat(10.0, 4, 30.0).unwrap(),
+        Cutter::flat(10.0, 4, 30f64.to_radians()).unwrap(),
         Cutter::flat(10.0, 4, 0.0).unwrap(),
         Cutter::new(
             8.0,
             vec![1.4, 1.7, 1.5, tau - 4.6],
-            35.0,
+            35f64.to_radians(),
             f64::INFINITY,
             RadiusProfile::Flat,
         )
         .unwrap(),
-        Cutter::new(6.0, vec![tau / 3.0; 3], 30.0, 20.0, RadiusProfile::Ball).unwrap(),
+        Cutter::new(6.0, vec![tau / 3.0; 3], 30f64.to_radians(), 20.0, RadiusProfile::Ball).unwrap(),
     ]
 }
 

@@ -7,7 +7,7 @@ use runout::{NoProgress, Source};
 /// Runout and coefficients from the bundled recordings (examples/identify, f_z 0.05, 0.08 mm).
 pub fn run() -> anyhow::Result<RecordingsReport> {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/identify");
-    let cutter = Cutter::flat(10.0, 4, 30.0)?; // D (mm), K, helix (deg)
+    let cutter = Cutter::flat(10.0, 4, 30f64.to_radians())?; // D (mm), K, helix (rad)
     let (mut sources, mut cuts) = (Vec::new(), Vec::new());
     for fz in [0.05, 0.08] {
         sources.push(Source::path(format!("{dir}/cut_fz{fz}.txt")));

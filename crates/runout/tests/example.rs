@@ -142,7 +142,7 @@ fn identify_reads_bytes_like_files_and_reports_progress() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/identify");
     let mut req = runout::identify::RecordingsRequest::new(
         Vec::new(),
-        runout::core::Cutter::flat(10.0, 4, 30.0).unwrap(),
+        runout::core::Cutter::flat(10.0, 4, 30f64.to_radians()).unwrap(),
         Vec::new(),
     );
     for fz in [0.05, 0.08] {
