@@ -38,6 +38,10 @@ enum Command {
     Shank(cmd::shank::Args),
     /// What a recording holds (.mat, TDMS, HDF5, Parquet, CSV): channels, units, lengths, rates.
     Inspect(cmd::inspect::Args),
+    /// Shell completions (bash, zsh, fish, elvish, powershell) to stdout.
+    Completions(cmd::install::CompletionsArgs),
+    /// Man pages generated from this program's options.
+    Man(cmd::install::ManArgs),
 }
 
 /// Status of a command whose standard output was closed early (`runout … | head -1`), as a
@@ -84,6 +88,10 @@ fn main() -> ExitCode {
         Command::Grind(a) => cmd::grind::run(a),
         Command::Shank(a) => cmd::shank::run(a),
         Command::Inspect(a) => cmd::inspect::run(a),
+        Command::Completions(a) => {
+            cmd::install::completions(a, <Cli as clap::CommandFactory>::command())
+        }
+        Command::Man(a) => cmd::install::man(a, <Cli as clap::CommandFactory>::command()),
     };
     // outputs appear only when the whole command succeeded (or only its stdout was cut short)
     let result = match result {
