@@ -4,6 +4,7 @@
 mod cmd;
 mod output;
 mod progress;
+mod provenance;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -80,6 +81,12 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
 fn main() -> ExitCode {
     quiet_on_broken_pipe();
     let cli = Cli::parse();
+    // the program by its name, not the path it was started from (the same on every machine)
+    let args: Vec<String> = std::env::args()
+        .enumerate()
+        .map(|(i, a)| if i == 0 { "runout".to_string() } else { a })
+        .collect();
+    provenance::start(args);
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Identify(a) => cmd::identify::run(a),

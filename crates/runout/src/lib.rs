@@ -24,6 +24,7 @@ pub mod chip;
 pub mod displacement;
 pub mod grind;
 pub mod job;
+pub mod provenance;
 pub mod schema;
 pub mod shank;
 pub mod spill;
