@@ -2,6 +2,7 @@
 //! (model and methods) and `runout-io` (formats): parse arguments, read, call, write.
 
 mod cmd;
+mod exit;
 mod output;
 mod progress;
 mod provenance;
@@ -15,7 +16,7 @@ use std::process::ExitCode;
 /// docs/conventions.md (teeth in cutting order, runout angle from tooth 0 in the
 /// direction of rotation, forces acting on the workpiece).
 #[derive(Parser, Debug)]
-#[command(name = "runout", version, about, long_about = None)]
+#[command(name = "runout", version, about, long_about = None, after_help = exit::HELP)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -113,10 +114,11 @@ fn main() -> ExitCode {
         }
     };
     match result {
+        Ok(()) if exit::is_not_identified() => ExitCode::from(exit::NOT_IDENTIFIED),
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {}", error_message(&e));
-            ExitCode::from(1)
+            ExitCode::from(exit::INPUT_ERROR)
         }
     }
 }
