@@ -2,9 +2,11 @@
 //! (model and methods) and `runout-io` (formats): parse arguments, read, call, write.
 
 mod cmd;
+mod exit;
 mod flags;
 mod output;
 mod progress;
+mod provenance;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -15,7 +17,7 @@ use std::process::ExitCode;
 /// docs/conventions.md (teeth in cutting order, runout angle from tooth 0 in the
 /// direction of rotation, forces acting on the workpiece).
 #[derive(Parser, Debug)]
-#[command(name = "runout", version, about, long_about = None)]
+#[command(name = "runout", version, about, long_about = None, after_help = exit::HELP)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -39,6 +41,10 @@ enum Command {
     Shank(cmd::shank::Args),
     /// What a recording holds (.mat, TDMS, HDF5, Parquet, CSV): channels, units, lengths, rates.
     Inspect(cmd::inspect::Args),
+    /// Shell completions (bash, zsh, fish, elvish, powershell) to stdout.
+    Completions(cmd::install::CompletionsArgs),
+    /// Man pages generated from this program's options.
+    Man(cmd::install::ManArgs),
 }
 
 /// Status of a command whose standard output was closed early (`runout … | head -1`), as a
@@ -77,6 +83,12 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
 fn main() -> ExitCode {
     quiet_on_broken_pipe();
     let cli = Cli::parse();
+    // the program by its name, not the path it was started from (the same on every machine)
+    let args: Vec<String> = std::env::args()
+        .enumerate()
+        .map(|(i, a)| if i == 0 { "runout".to_string() } else { a })
+        .collect();
+    provenance::start(args);
     let result = match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Identify(a) => cmd::identify::run(a),
@@ -85,6 +97,10 @@ fn main() -> ExitCode {
         Command::Grind(a) => cmd::grind::run(a),
         Command::Shank(a) => cmd::shank::run(a),
         Command::Inspect(a) => cmd::inspect::run(a),
+        Command::Completions(a) => {
+            cmd::install::completions(a, <Cli as clap::CommandFactory>::command())
+        }
+        Command::Man(a) => cmd::install::man(a, <Cli as clap::CommandFactory>::command()),
     };
     // outputs appear only when the whole command succeeded (or only its stdout was cut short)
     let result = match result {
@@ -99,10 +115,11 @@ fn main() -> ExitCode {
         }
     };
     match result {
+        Ok(()) if exit::is_not_identified() => ExitCode::from(exit::NOT_IDENTIFIED),
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {}", error_message(&e));
-            ExitCode::from(1)
+            ExitCode::from(exit::INPUT_ERROR)
         }
     }
 }

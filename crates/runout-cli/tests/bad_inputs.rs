@@ -278,6 +278,35 @@ fn write_inputs(dir: &Path, files: &[(&str, Src)]) {
 }
 
 /// The problems of one row (empty when it passes).
+/// Issue 21 item 4: messages in the user's words — no module paths (`identify::full_signal`), no
+/// Debug spellings (`Some(…)`, `Foo { … }`, `[1.0, 2.0]` from `{:?}`), no citation of a file the user
+/// does not have (the spec is cited as `docs/methods.md`, which ships with the sources).
+fn words_from_the_code(message: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    for token in [
+        "::",
+        "Some(",
+        "None",
+        "Ok(",
+        "Err(",
+        " { ",
+        "\\\"",
+        "ParamError",
+        "Error {",
+    ] {
+        if message.contains(token) {
+            found.push(token.to_string());
+        }
+    }
+    let bare_spec = message
+        .match_indices("methods.md")
+        .any(|(i, _)| !message[..i].ends_with("docs/"));
+    if bare_spec {
+        found.push("methods.md without docs/".into());
+    }
+    found
+}
+
 fn check(row: &Row) -> Vec<String> {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
@@ -302,6 +331,9 @@ fn check(row: &Row) -> Vec<String> {
     }
     if err.contains("panicked") || !err.starts_with("error: ") {
         problems.push("not a plain `error: …` message".into());
+    }
+    for w in words_from_the_code(&err) {
+        problems.push(format!("words from the code: `{w}`"));
     }
     for w in row.expect {
         if !err.contains(w) {
@@ -435,4 +467,18 @@ fn errors_end_with_what_to_do() {
                 .ends_with("(see `runout identify peaks --help`)"),
         "{err}"
     );
+}
+
+#[test]
+fn the_words_from_the_code_check_catches_them() {
+    assert_eq!(
+        words_from_the_code("error: identify::full_signal failed"),
+        ["::"]
+    );
+    assert_eq!(words_from_the_code("value Some(3.0)"), ["Some("]);
+    assert_eq!(
+        words_from_the_code("see methods.md §4.2"),
+        ["methods.md without docs/"]
+    );
+    assert!(words_from_the_code("see docs/methods.md §4.2 and pass --helix-deg").is_empty());
 }

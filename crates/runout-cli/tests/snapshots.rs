@@ -32,8 +32,57 @@ fn run(args: &[&str], tmp: &Path) -> String {
     );
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.starts_with('{'), "{args:?}: not JSON: {text}");
-    serde_json::from_str::<serde_json::Value>(&text).expect("valid JSON");
-    text.replace(tmp.to_str().unwrap(), "[TMP]")
+    let v = serde_json::from_str::<serde_json::Value>(&text).expect("valid JSON");
+    check_provenance(&v["provenance"], args);
+    // the report without its provenance (last field; it differs per run): the snapshot
+    let cut = text
+        .find(",\n  \"provenance\": {")
+        .expect("provenance is the last field");
+    (text[..cut].to_string() + "\n}\n").replace(tmp.to_str().unwrap(), "[TMP]")
+}
+
+/// Issue 21 item 6: tool version, the command line as given, every input file named on it with
+/// its size and SHA-256 (checked against the system's `sha256sum`, an independent
+/// implementation), and the time (RFC 3339 UTC).
+fn check_provenance(p: &serde_json::Value, args: &[&str]) {
+    assert_eq!(p["tool"], format!("runout {}", env!("CARGO_PKG_VERSION")));
+    let line: Vec<&str> = p["command_line"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_str().unwrap())
+        .collect();
+    assert_eq!(line[0], "runout");
+    assert_eq!(&line[1..], args);
+    let root = example("..");
+    for input in p["inputs"].as_array().unwrap() {
+        let name = input["name"].as_str().unwrap();
+        assert!(
+            args.contains(&name) || args.iter().any(|a| a.starts_with(name)),
+            "{name}"
+        );
+        let path = root.join(name);
+        assert_eq!(
+            input["size_bytes"],
+            fs::metadata(&path).unwrap().len(),
+            "{name}"
+        );
+        let sum = std::process::Command::new("sha256sum")
+            .arg(&path)
+            .output()
+            .unwrap();
+        let sum = String::from_utf8(sum.stdout).unwrap();
+        assert_eq!(
+            input["sha256"],
+            sum.split_whitespace().next().unwrap(),
+            "{name}"
+        );
+    }
+    let t = p["created_utc"].as_str().unwrap();
+    assert!(
+        t.len() == 20 && t.ends_with('Z') && &t[4..5] == "-" && &t[10..11] == "T",
+        "{t}"
+    );
 }
 
 fn tmp() -> tempfile::TempDir {

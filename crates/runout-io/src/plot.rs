@@ -3,6 +3,7 @@
 
 pub mod chip;
 pub mod identify;
+pub mod metadata;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -117,6 +118,13 @@ macro_rules! render_plot {
                     })
             }
         };
+        // provenance into the file's metadata (plot::metadata), then the rename
+        let drawn = drawn.and_then(|()| {
+            $crate::plot::metadata::embed(&tmp, format).map_err(|e| $crate::plot::PlotError::Draw {
+                path: p.clone(),
+                message: format!("cannot write: {}", $crate::report::io_problem(&e)),
+            })
+        });
         match drawn {
             Ok(()) => std::fs::rename(&tmp, final_path).map_err(|e| {
                 let _ = std::fs::remove_file(&tmp);

@@ -84,6 +84,14 @@ impl Source {
         }
     }
 
+    /// The bytes, if the source is held in memory.
+    pub fn as_bytes(&self) -> Option<&[u8]> {
+        match &self.kind {
+            Kind::Path(_) => None,
+            Kind::Bytes(b) => Some(b),
+        }
+    }
+
     /// The folder that relative file names inside this source are resolved from (the file's
     /// folder; `.` for bytes).
     pub fn dir(&self) -> &Path {

@@ -27,6 +27,7 @@ pub mod grind;
 pub mod identify;
 pub mod inspect;
 pub mod job;
+pub mod provenance;
 pub mod schema;
 pub mod shank;
 pub mod simulate;

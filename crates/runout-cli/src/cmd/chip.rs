@@ -145,7 +145,7 @@ fn compare(a: CompareArgs) -> Result<()> {
     }
     check_outputs(&[&a.json], &report.inputs)?;
     if let Some(j) = &a.json {
-        output::write_text(j, &runout::to_json(&report)?)?;
+        output::write_text(j, &crate::provenance::stamped_json(&report)?)?;
     }
     if a.json.as_deref() != Some(Path::new("-")) {
         print!("{}", render::compare_text(&report));
@@ -191,7 +191,7 @@ fn eval(a: EvalArgs) -> Result<()> {
         render::eval_map_plot(p, &report)?;
     }
     if let Some(j) = &a.json {
-        output::write_text(j, &runout::to_json(&report)?)?;
+        output::write_text(j, &crate::provenance::stamped_json(&report)?)?;
     }
     let to_stdout = |p: &Option<PathBuf>| p.as_deref() == Some(Path::new("-"));
     if !to_stdout(&a.json) && !to_stdout(&a.out) {

@@ -29,7 +29,7 @@ pub fn run(a: Args) -> Result<()> {
         sample_rate_hz: a.sample_rate_hz,
     })?;
     if a.json {
-        print!("{}", runout::to_json(&report)?);
+        print!("{}", crate::provenance::stamped_json(&report)?);
     } else {
         print!("{}", render::text(&report));
     }

@@ -157,7 +157,7 @@ fn emit<R: runout::Report>(
     text: impl FnOnce() -> String,
 ) -> Result<()> {
     if let Some(p) = json {
-        output::write_text(p, &runout::to_json(report)?)?;
+        output::write_text(p, &crate::provenance::stamped_json(report)?)?;
     }
     if json != Some(Path::new("-")) {
         print!("{}", text());
@@ -227,7 +227,7 @@ fn force(a: ForceArgs) -> Result<()> {
     }
     let report = shank::force_to(&req, writer, &mut crate::progress::Bars::default())?;
     if let Some(p) = &a.json {
-        output::write_text(p, &runout::to_json(&report)?)?;
+        output::write_text(p, &crate::provenance::stamped_json(&report)?)?;
     }
     if let Some(dir) = &a.plot_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;

@@ -237,7 +237,7 @@ pub fn run(a: Args) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(j) = &a.json {
-        output::write_text(j, &runout::to_json(&report)?)?;
+        output::write_text(j, &crate::provenance::stamped_json(&report)?)?;
     }
     if let Some(p) = &plot {
         a.plots.create_dir()?;
@@ -248,13 +248,4 @@ pub fn run(a: Args) -> Result<()> {
         print!("{}", render::text(&report));
     }
     Ok(())
-}
-
-/// Settings from an optional TOML file overlaid by flags ([`runout::case::settings`]).
-pub fn settings(
-    config: Option<&Path>,
-    flags: Layer,
-    known: &[&str],
-) -> Result<runout_io::config::Settings> {
-    runout::case::settings(config.map(Source::path).as_ref(), flags, known)
 }

@@ -67,7 +67,7 @@ impl OutputFlags {
     /// Write JSON and text (text to stdout unless the JSON goes there).
     pub fn write<R: runout::Report>(&self, report: &R, text: &str) -> Result<()> {
         if let Some(j) = &self.json {
-            crate::output::write_text(j, &runout::to_json(report)?)?;
+            crate::output::write_text(j, &crate::provenance::stamped_json(report)?)?;
         }
         let json_on_stdout = self.json.as_deref() == Some(Path::new("-"));
         match &self.text {

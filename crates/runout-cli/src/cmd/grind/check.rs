@@ -105,7 +105,7 @@ pub fn run(a: CheckArgs) -> Result<()> {
         edge: a.edge.generated_edge()?,
     })?;
     if let Some(j) = &a.json {
-        output::write_text(j, &runout::to_json(&report)?)?;
+        output::write_text(j, &crate::provenance::stamped_json(&report)?)?;
         if j.as_os_str() == "-" {
             return Ok(());
         }

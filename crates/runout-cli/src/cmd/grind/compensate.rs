@@ -224,7 +224,7 @@ pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
         render::compensate_plots(dir, f.ext(), &report)?;
     }
     if let Some(j) = &a.json {
-        output::write_text(j, &runout::to_json(&report)?)?;
+        output::write_text(j, &crate::provenance::stamped_json(&report)?)?;
     }
     let to_stdout = |p: &Option<PathBuf>| p.as_deref() == Some(Path::new("-"));
     if !to_stdout(&a.json) && !to_stdout(&a.path_out) {

@@ -49,7 +49,7 @@ fn emit<R: runout::Report>(
     text: impl FnOnce() -> String,
 ) -> Result<()> {
     if let Some(p) = json {
-        crate::output::write_text(p, &runout::to_json(report)?)?;
+        crate::output::write_text(p, &crate::provenance::stamped_json(report)?)?;
     }
     if json != Some(std::path::Path::new("-")) {
         print!("{}", text());

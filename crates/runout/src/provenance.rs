@@ -1,0 +1,220 @@
+//! Provenance of a report (issue 21 item 6): which program made it, from which command, from which
+//! inputs (name, size, SHA-256) and when — so the same report made on two machines can be compared,
+//! and a report can be traced back to its recordings.
+//!
+//! Jobs return their report alone; a front end that writes it stamps it:
+//!
+//! ```
+//! use runout::provenance::{Provenance, Stamped};
+//! use runout::Source;
+//! let inputs = [Source::bytes("rec.csv", b"time_s,Fx_N\n0,1\n".to_vec())];
+//! let provenance = Provenance::new(["runout", "identify", "rec.csv"], &inputs)?;
+//! assert_eq!(provenance.inputs[0].size_bytes, 16);
+//! assert_eq!(provenance.inputs[0].sha256.len(), 64);
+//! assert!(provenance.tool.starts_with("runout "));
+//! # Ok::<(), std::io::Error>(())
+//! ```
+//!
+//! [`Stamped`] serialises as the report's own fields followed by `provenance`, so a stamped JSON is
+//! the report's JSON plus one field.
+
+use crate::job::Source;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::io::Read;
+
+/// Where a report came from.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub struct Provenance {
+    /// Program and version, e.g. `runout 0.1.0`.
+    pub tool: String,
+    /// The command line as given (program name first), or the calling front end's equivalent
+    /// (e.g. `["python", "runout.identify", …]`).
+    pub command_line: Vec<String>,
+    /// Every input file or in-memory source the job read, in the order given.
+    pub inputs: Vec<InputFile>,
+    /// When the report was made: UTC, RFC 3339 with seconds (`2026-11-25T07:12:03Z`).
+    pub created_utc: String,
+}
+
+/// One input of a report.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub struct InputFile {
+    /// The name the input was given by (a path as typed, or the name of in-memory bytes).
+    pub name: String,
+    /// Size in bytes.
+    pub size_bytes: u64,
+    /// SHA-256 of the content, lower-case hex (64 characters).
+    pub sha256: String,
+}
+
+impl Provenance {
+    /// Provenance of a report made now by this program from `inputs`, for the command line
+    /// `command_line`. Reads each input once to hash it (files are streamed: memory does not grow
+    /// with their size); an input that cannot be read is an error naming it.
+    pub fn new<I, S>(command_line: I, inputs: &[Source]) -> std::io::Result<Self>
+    where
+        I: IntoIterator<Item = S>,
+        S: Into<String>,
+    {
+        Ok(Self {
+            tool: format!("runout {}", env!("CARGO_PKG_VERSION")),
+            command_line: command_line.into_iter().map(Into::into).collect(),
+            inputs: inputs.iter().map(InputFile::of).collect::<Result<_, _>>()?,
+            created_utc: utc_now_rfc3339(),
+        })
+    }
+
+    /// One line for the metadata of a plot: tool, time, command line and the inputs' hashes
+    /// (first 12 hex digits).
+    pub fn summary_line(&self) -> String {
+        let inputs: Vec<String> = self
+            .inputs
+            .iter()
+            .map(|i| format!("{} sha256:{}", i.name, &i.sha256[..12]))
+            .collect();
+        format!(
+            "{} at {}: {} [inputs: {}]",
+            self.tool,
+            self.created_utc,
+            self.command_line.join(" "),
+            inputs.join(", ")
+        )
+    }
+}
+
+impl InputFile {
+    /// Name, size and SHA-256 of one source.
+    pub fn of(source: &Source) -> std::io::Result<Self> {
+        let mut hasher = Sha256::new();
+        let size_bytes = match source.as_path() {
+            Some(path) => {
+                let mut file = std::fs::File::open(path).map_err(|e| named(source, e))?;
+                let mut buf = vec![0u8; 1 << 16];
+                let mut total = 0u64;
+                loop {
+                    let n = file.read(&mut buf).map_err(|e| named(source, e))?;
+                    if n == 0 {
+                        break;
+                    }
+                    hasher.update(&buf[..n]);
+                    total += n as u64;
+                }
+                total
+            }
+            None => {
+                let bytes = source.as_bytes().unwrap_or_default();
+                hasher.update(bytes);
+                bytes.len() as u64
+            }
+        };
+        Ok(Self {
+            name: source.name().to_string(),
+            size_bytes,
+            sha256: hex(&hasher.finalize()),
+        })
+    }
+}
+
+fn named(source: &Source, e: std::io::Error) -> std::io::Error {
+    std::io::Error::new(
+        e.kind(),
+        format!("{}: cannot read to hash it: {e}", source.name()),
+    )
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// A report with its provenance: serialises as the report's fields followed by `provenance`.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct Stamped<'a, R: Serialize + JsonSchema> {
+    /// The report.
+    #[serde(flatten)]
+    pub report: &'a R,
+    /// Where it came from.
+    pub provenance: &'a Provenance,
+}
+
+/// Now, UTC, as RFC 3339 with whole seconds.
+pub fn utc_now_rfc3339() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    rfc3339_from_unix(secs)
+}
+
+/// `secs` after 1970-01-01T00:00:00Z as RFC 3339 (UTC, `Z`). Days to civil date by Howard
+/// Hinnant's `civil_from_days` (proleptic Gregorian calendar).
+pub fn rfc3339_from_unix(secs: u64) -> String {
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rfc3339_of_known_instants() {
+        assert_eq!(rfc3339_from_unix(0), "1970-01-01T00:00:00Z");
+        assert_eq!(rfc3339_from_unix(951_782_400), "2000-02-29T00:00:00Z");
+        assert_eq!(rfc3339_from_unix(1_795_650_723), "2026-11-25T23:52:03Z");
+        assert_eq!(rfc3339_from_unix(4_107_542_399), "2100-02-28T23:59:59Z");
+    }
+
+    #[test]
+    fn sha256_of_known_content() {
+        // FIPS 180-2 test vector "abc"
+        let i = InputFile::of(&Source::bytes("abc", b"abc".to_vec())).unwrap();
+        assert_eq!(
+            i.sha256,
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+        assert_eq!(i.size_bytes, 3);
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("abc.txt");
+        std::fs::write(&p, "abc").unwrap();
+        assert_eq!(InputFile::of(&Source::path(&p)).unwrap().sha256, i.sha256);
+        let missing = InputFile::of(&Source::path(dir.path().join("none.csv"))).unwrap_err();
+        assert!(missing.to_string().contains("none.csv"), "{missing}");
+    }
+
+    #[test]
+    fn stamped_is_the_report_plus_provenance() {
+        #[derive(Serialize, JsonSchema)]
+        struct R {
+            schema: &'static str,
+            offset_um: f64,
+        }
+        let p = Provenance::new(["runout", "x"], &[]).unwrap();
+        let v = serde_json::to_value(Stamped {
+            report: &R {
+                schema: "runout.x/1",
+                offset_um: 8.0,
+            },
+            provenance: &p,
+        })
+        .unwrap();
+        assert_eq!(v["offset_um"], 8.0);
+        assert_eq!(v["provenance"]["command_line"][1], "x");
+        assert_eq!(v.as_object().unwrap().len(), 3);
+    }
+}
