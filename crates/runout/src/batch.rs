@@ -1,0 +1,391 @@
+//! `runout batch`: one analysis (the identify job) over many recordings, in parallel, into one
+//! summary table.
+//!
+//! * **Inputs**: a folder (every regular, non-hidden file in it, sorted) or a glob pattern
+//!   (`cuts/**/*.txt`), or explicit files — [`expand`].
+//! * **Parallel, bounded memory**: a rayon pool of `threads` workers; each worker holds one
+//!   recording's analysis at a time (the identify job streams its recording), and the finished
+//!   rows (a few hundred bytes each) are written to the summary as they complete. Memory is
+//!   `threads` × one analysis, whatever the number of files.
+//! * **Continues past bad files**: a failed analysis is a row with `status = error` and the
+//!   message; the run goes on.
+//! * **Resumable**: files already in the summary (ok or error) are skipped; rows are appended and
+//!   flushed one by one, so an interrupted run loses at most the analyses in flight. At the end the
+//!   table is rewritten sorted by file (atomically: temporary file + rename).
+//!
+//! The analysis is a closure ([`run`]), so the framework is tested without a recording format;
+//! `runout batch` plugs in the identify job.
+
+#![allow(non_snake_case)] // field names carry their units, as the JSON and CSV columns do
+
+use crate::job::Report;
+use anyhow::{bail, Context, Result};
+use rayon::prelude::*;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// One row of the summary table (CSV columns in this order; empty cells for values not
+/// available). Angles in degrees, offsets in µm, coefficients in N/mm² (cutting) and N/mm (edge).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Row {
+    /// The recording, as given (path).
+    pub file: String,
+    /// `ok` or `error`.
+    pub status: String,
+    /// The error message (`status = error`), else empty.
+    pub error: String,
+    /// Time of the recording: from its header when the analysis finds one, else the file's
+    /// modification time (UTC, RFC 3339).
+    pub time: String,
+    /// Runout offset ρ (µm) and its standard error.
+    pub offset_um: Option<f64>,
+    pub offset_se_um: Option<f64>,
+    /// Runout angle λ (deg, from tooth 0 in the direction of rotation) and its standard error.
+    pub angle_deg: Option<f64>,
+    pub angle_se_deg: Option<f64>,
+    /// Cutting coefficients K_tc, K_rc, K_ac (N/mm²) and their standard errors.
+    pub ktc_N_per_mm2: Option<f64>,
+    pub ktc_se_N_per_mm2: Option<f64>,
+    pub krc_N_per_mm2: Option<f64>,
+    pub krc_se_N_per_mm2: Option<f64>,
+    pub kac_N_per_mm2: Option<f64>,
+    pub kac_se_N_per_mm2: Option<f64>,
+    /// Edge coefficients K_te, K_re, K_ae (N/mm) and their standard errors.
+    pub kte_N_per_mm: Option<f64>,
+    pub kte_se_N_per_mm: Option<f64>,
+    pub kre_N_per_mm: Option<f64>,
+    pub kre_se_N_per_mm: Option<f64>,
+    pub kae_N_per_mm: Option<f64>,
+    pub kae_se_N_per_mm: Option<f64>,
+    /// Fit quality: coefficient of determination R² of the runout fit, RMS residual (N) and
+    /// condition number of the fit.
+    pub r_squared: Option<f64>,
+    pub residual_rms_N: Option<f64>,
+    pub condition: Option<f64>,
+    /// The analysis's verdict (e.g. runout within tolerance), when it gives one.
+    pub verdict: String,
+}
+
+/// A failed file.
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
+pub struct Failure {
+    pub file: String,
+    pub error: String,
+}
+
+/// `runout batch`: the files, the summary, the pool.
+#[derive(Debug, Clone)]
+pub struct BatchRequest {
+    /// The recordings (see [`expand`]).
+    pub files: Vec<PathBuf>,
+    /// The summary table (CSV); read first to skip files already analysed.
+    pub summary: PathBuf,
+    /// Worker threads (default: rayon's, i.e. the number of cores or `RAYON_NUM_THREADS`).
+    pub threads: Option<usize>,
+    /// Analyse again the files whose row in the summary is an error.
+    pub retry_errors: bool,
+}
+
+/// `runout.batch/1`: what a batch run did.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct BatchReport {
+    /// `runout.batch/1`
+    #[schemars(extend("const" = "runout.batch/1"))]
+    pub schema: String,
+    pub summary: String,
+    /// Files given.
+    pub files: usize,
+    /// Files skipped because the summary already had them.
+    pub skipped: usize,
+    /// Files analysed in this run.
+    pub analysed: usize,
+    /// Of those, analysed successfully.
+    pub ok: usize,
+    /// Of those, failed (each with its message).
+    pub failed: Vec<Failure>,
+    /// Rows in the summary after the run.
+    pub rows: usize,
+    pub threads: usize,
+    pub elapsed_s: f64,
+    /// `analysed / elapsed_s`.
+    pub recordings_per_s: f64,
+}
+
+impl Report for BatchReport {
+    const SCHEMA: &'static str = "runout.batch/1";
+}
+
+/// The files of `spec`: a folder (its regular, non-hidden files, sorted; not recursive), a
+/// glob pattern (`*`, `?`, `[…]`, `**`; matches sorted), or one file. A pattern that matches
+/// nothing, or an empty folder, is an error naming it.
+pub fn expand(spec: &str) -> Result<Vec<PathBuf>> {
+    let p = Path::new(spec);
+    if p.is_dir() {
+        let mut v = Vec::new();
+        for e in std::fs::read_dir(p).with_context(|| format!("reading folder {spec}"))? {
+            let e = e.with_context(|| format!("reading folder {spec}"))?;
+            let hidden = e.file_name().to_string_lossy().starts_with('.');
+            if !hidden && e.file_type().map(|t| t.is_file()).unwrap_or(false) {
+                v.push(e.path());
+            }
+        }
+        v.sort();
+        if v.is_empty() {
+            bail!("{spec}: the folder holds no files");
+        }
+        return Ok(v);
+    }
+    if p.is_file() {
+        return Ok(vec![p.to_path_buf()]);
+    }
+    let mut v: Vec<PathBuf> = glob::glob(spec)
+        .with_context(|| format!("pattern `{spec}`"))?
+        .filter_map(|e| e.ok())
+        .filter(|p| p.is_file())
+        .collect();
+    v.sort();
+    if v.is_empty() {
+        bail!("{spec}: no such file or folder, and no file matches it as a pattern");
+    }
+    Ok(v)
+}
+
+/// Rows of an existing summary (none if the file does not exist).
+pub fn read_summary(path: &Path) -> Result<Vec<Row>> {
+    if !path.exists() {
+        return Ok(Vec::new());
+    }
+    let mut r = csv::Reader::from_path(path)
+        .with_context(|| format!("reading the summary {}", path.display()))?;
+    let mut rows = Vec::new();
+    for (i, row) in r.deserialize::<Row>().enumerate() {
+        rows.push(row.with_context(|| {
+            format!(
+                "{}:{}: not a row of a batch summary (delete or move the file to start afresh)",
+                path.display(),
+                i + 2
+            )
+        })?);
+    }
+    Ok(rows)
+}
+
+/// Write `rows` as the summary CSV (header first).
+pub fn write_summary(w: impl std::io::Write, rows: &[Row]) -> Result<()> {
+    if rows.is_empty() {
+        // the header alone: the first line of a serialised row
+        let mut probe = csv::Writer::from_writer(Vec::new());
+        probe.serialize(Row::default())?;
+        let bytes = probe.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?;
+        let header = bytes.split(|&b| b == b'\n').next().unwrap_or_default();
+        let mut w = w;
+        w.write_all(header)?;
+        w.write_all(b"\n")?;
+        w.flush()?;
+        return Ok(());
+    }
+    let mut w = csv::Writer::from_writer(w);
+    for r in rows {
+        w.serialize(r)?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
+fn mtime_utc(path: &Path) -> String {
+    let Ok(t) = std::fs::metadata(path).and_then(|m| m.modified()) else {
+        return String::new();
+    };
+    let Ok(d) = t.duration_since(std::time::UNIX_EPOCH) else {
+        return String::new();
+    };
+    rfc3339(d.as_secs() as i64)
+}
+
+/// Seconds since 1970 as `YYYY-MM-DDThh:mm:ssZ` (proleptic Gregorian, UTC).
+pub fn rfc3339(secs: i64) -> String {
+    let days = secs.div_euclid(86_400);
+    let s = secs.rem_euclid(86_400);
+    // civil from days (H. Hinnant's algorithm)
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let y = yoe + era * 400;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = if m <= 2 { y + 1 } else { y };
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        s / 3600,
+        s / 60 % 60,
+        s % 60
+    )
+}
+
+/// Run `analyse` on every file of `req` not yet in the summary, in parallel; append each row to
+/// the summary as it completes; rewrite the summary sorted by file at the end. `analyse` returns
+/// the measurements of a row (its `file`, `status` and `error` are set here, and `time` when it
+/// leaves it empty); an `Err` becomes an error row with the message (the error and its causes).
+/// `on_row` is called for every finished row (from the worker threads), e.g. for progress.
+pub fn run<F>(req: &BatchRequest, analyse: F, on_row: &(dyn Fn(&Row) + Sync)) -> Result<BatchReport>
+where
+    F: Fn(&Path) -> Result<Row> + Sync,
+{
+    let start = Instant::now();
+    let mut existing = read_summary(&req.summary)?;
+    if req.retry_errors {
+        existing.retain(|r| r.status != "error");
+    }
+    let done: BTreeSet<&str> = existing.iter().map(|r| r.file.as_str()).collect();
+    let mut todo: Vec<&PathBuf> = Vec::new();
+    let mut seen = BTreeSet::new();
+    for f in &req.files {
+        let name = f.display().to_string();
+        if !done.contains(name.as_str()) && seen.insert(name) {
+            todo.push(f);
+        }
+    }
+    let skipped = req.files.len() - todo.len();
+    // the summary so far (rewritten when errors are retried), then rows appended as they finish
+    let mut file = write_then_append(&req.summary, &existing)?;
+    let pool = {
+        let mut b = rayon::ThreadPoolBuilder::new();
+        if let Some(n) = req.threads {
+            if n == 0 {
+                bail!("threads: expected at least 1, got 0");
+            }
+            b = b.num_threads(n);
+        }
+        b.build().context("starting the worker threads")?
+    };
+    let threads = pool.current_num_threads();
+    let sink = Mutex::new((
+        csv::WriterBuilder::new()
+            .has_headers(false)
+            .from_writer(&mut file),
+        Vec::<Row>::with_capacity(todo.len()),
+        None::<anyhow::Error>,
+    ));
+    pool.install(|| {
+        todo.par_iter().with_max_len(1).for_each(|path| {
+            let name = path.display().to_string();
+            let row = match analyse(path) {
+                Ok(mut r) => {
+                    r.file = name;
+                    r.status = "ok".into();
+                    r.error.clear();
+                    if r.time.is_empty() {
+                        r.time = mtime_utc(path);
+                    }
+                    r
+                }
+                Err(e) => Row {
+                    file: name,
+                    status: "error".into(),
+                    error: runout_io::report::chain_of(e.chain()),
+                    time: mtime_utc(path),
+                    ..Row::default()
+                },
+            };
+            on_row(&row);
+            let mut s = sink.lock().expect("not poisoned");
+            let written = s.0.serialize(&row).and_then(|_| Ok(s.0.flush()?));
+            if let Err(e) = written {
+                s.2.get_or_insert(anyhow::Error::new(e).context(format!(
+                    "appending to the summary {}",
+                    req.summary.display()
+                )));
+            }
+            s.1.push(row);
+        })
+    });
+    let (w, new_rows, err) = sink.into_inner().expect("not poisoned");
+    drop(w);
+    if let Some(e) = err {
+        return Err(e);
+    }
+    let elapsed_s = start.elapsed().as_secs_f64();
+    let analysed = new_rows.len();
+    let failed: Vec<Failure> = new_rows
+        .iter()
+        .filter(|r| r.status == "error")
+        .map(|r| Failure {
+            file: r.file.clone(),
+            error: r.error.clone(),
+        })
+        .collect();
+    let ok = analysed - failed.len();
+    let mut all = existing;
+    all.extend(new_rows);
+    all.sort_by(|a, b| a.file.cmp(&b.file));
+    // sorted, atomically: a crash here leaves the appended file, which resumes as well
+    let tmp = tmp_next_to(&req.summary);
+    let out = std::fs::File::create(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
+    write_summary(std::io::BufWriter::new(out), &all)
+        .with_context(|| format!("writing {}", tmp.display()))?;
+    std::fs::rename(&tmp, &req.summary)
+        .with_context(|| format!("replacing {}", req.summary.display()))?;
+    Ok(BatchReport {
+        schema: BatchReport::SCHEMA.into(),
+        summary: req.summary.display().to_string(),
+        files: req.files.len(),
+        skipped,
+        analysed,
+        ok,
+        failed,
+        rows: all.len(),
+        threads,
+        elapsed_s,
+        recordings_per_s: if elapsed_s > 0.0 {
+            analysed as f64 / elapsed_s
+        } else {
+            0.0
+        },
+    })
+}
+
+fn tmp_next_to(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| "summary.csv".into());
+    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+}
+
+/// Write `rows` (with the header) to `path` and return it open for appending.
+fn write_then_append(path: &Path, rows: &[Row]) -> Result<std::fs::File> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let tmp = tmp_next_to(path);
+    {
+        let f =
+            std::fs::File::create(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
+        write_summary(std::io::BufWriter::new(f), rows)
+            .with_context(|| format!("writing {}", tmp.display()))?;
+    }
+    std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))?;
+    std::fs::OpenOptions::new()
+        .append(true)
+        .open(path)
+        .with_context(|| format!("opening {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dates() {
+        assert_eq!(rfc3339(0), "1970-01-01T00:00:00Z");
+        assert_eq!(rfc3339(951_782_400), "2000-02-29T00:00:00Z");
+        assert_eq!(rfc3339(1_795_568_461), "2026-11-25T01:01:01Z");
+    }
+}
