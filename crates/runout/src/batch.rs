@@ -196,6 +196,103 @@ pub fn write_summary(w: impl std::io::Write, rows: &[Row]) -> Result<()> {
     Ok(())
 }
 
+/// The summary row of an identify report (`runout.identify.recording/1`, as JSON): ρ, λ and the
+/// coefficients with their standard errors and the fit quality from the full-signal fit (the
+/// seed-003 sine fit of the first recording when there is no full-signal fit), the recording's
+/// date and time from its header when it states them, and as verdict `identified` or
+/// `not identified: <parameter> (<reason>), …` from the report's status.
+pub fn row_from_identify(report: &serde_json::Value) -> Row {
+    let num = |v: &serde_json::Value, k: &str| v.get(k).and_then(serde_json::Value::as_f64);
+    let mut row = Row::default();
+    let full = report.get("full_signal").filter(|v| !v.is_null());
+    if let Some(f) = full {
+        row.offset_um = num(f, "offset_um");
+        row.offset_se_um = num(f, "offset_um_se");
+        row.angle_deg = num(f, "angle_deg");
+        row.angle_se_deg = num(f, "angle_deg_se");
+        row.r_squared = num(f, "r_squared");
+        row.residual_rms_N = num(f, "residual_rms_N");
+        row.condition = num(f, "condition");
+        if let Some(c) = f.get("coefficients").filter(|v| !v.is_null()) {
+            let k = |name: &str| (num(c, name), num(c, &format!("{name}_se")));
+            (row.ktc_N_per_mm2, row.ktc_se_N_per_mm2) = k("ktc_N_per_mm2");
+            (row.krc_N_per_mm2, row.krc_se_N_per_mm2) = k("krc_N_per_mm2");
+            (row.kac_N_per_mm2, row.kac_se_N_per_mm2) = k("kac_N_per_mm2");
+            (row.kte_N_per_mm, row.kte_se_N_per_mm) = k("kte_N_per_mm");
+            (row.kre_N_per_mm, row.kre_se_N_per_mm) = k("kre_N_per_mm");
+            (row.kae_N_per_mm, row.kae_se_N_per_mm) = k("kae_N_per_mm");
+        }
+    }
+    let first = report
+        .get("recordings")
+        .and_then(|r| r.as_array())
+        .and_then(|r| r.first());
+    if full.is_none() {
+        if let Some(sf) = first
+            .and_then(|r| r.get("sine_fit"))
+            .filter(|v| !v.is_null())
+        {
+            row.offset_um = num(sf, "offset_um");
+            row.offset_se_um = num(sf, "offset_um_se").or(num(sf, "offset_se_um"));
+            row.angle_deg = num(sf, "angle_deg");
+            row.angle_se_deg = num(sf, "angle_deg_se").or(num(sf, "angle_se_deg"));
+        }
+    }
+    // date/time stated in the header (DynoWare `Date`, `Time`, …)
+    if let Some(meta) = first
+        .and_then(|r| r.get("metadata"))
+        .and_then(|m| m.as_array())
+    {
+        let mut parts = Vec::new();
+        for kv in meta {
+            let (Some(k), Some(v)) = (
+                kv.get(0).and_then(|k| k.as_str()),
+                kv.get(1).and_then(|v| v.as_str()),
+            ) else {
+                continue;
+            };
+            let key = k.to_ascii_lowercase();
+            let key = key.trim();
+            if [
+                "date",
+                "time",
+                "datetime",
+                "timestamp",
+                "start time",
+                "measuring date",
+            ]
+            .contains(&key)
+            {
+                parts.push(v.trim().to_string());
+            }
+        }
+        row.time = parts.join(" ");
+    }
+    let mut missing = Vec::new();
+    if let Some(ps) = report
+        .get("status")
+        .and_then(|s| s.get("parameters"))
+        .and_then(|p| p.as_array())
+    {
+        for p in ps {
+            let status = p.get("status").and_then(|s| s.as_str()).unwrap_or("");
+            if status != "identified" {
+                let name = p.get("parameter").and_then(|s| s.as_str()).unwrap_or("?");
+                match p.get("reason").and_then(|s| s.as_str()) {
+                    Some(r) => missing.push(format!("{name} ({r})")),
+                    None => missing.push(name.to_string()),
+                }
+            }
+        }
+        row.verdict = if missing.is_empty() {
+            "identified".into()
+        } else {
+            format!("not identified: {}", missing.join(", "))
+        };
+    }
+    row
+}
+
 fn mtime_utc(path: &Path) -> String {
     let Ok(t) = std::fs::metadata(path).and_then(|m| m.modified()) else {
         return String::new();
@@ -381,6 +478,44 @@ fn write_then_append(path: &Path, rows: &[Row]) -> Result<std::fs::File> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_row_from_an_identify_report() {
+        let report = serde_json::json!({
+            "schema": "runout.identify.recording/1",
+            "recordings": [{"metadata": [["Date", "2026-11-25"], ["Time", "07:10:00"], ["Noise", "2%"]],
+                            "sine_fit": {"offset_um": 6.0, "angle_deg": 1.0}}],
+            "full_signal": {"offset_um": 7.9, "offset_um_se": 0.1, "angle_deg": -49.8, "angle_deg_se": 1.2,
+                            "coefficients": {"ktc_N_per_mm2": 1895.0, "ktc_N_per_mm2_se": 38.0,
+                                             "kae_N_per_mm": -2.6, "kae_N_per_mm_se": 0.4},
+                            "residual_rms_N": 1.8, "r_squared": 0.9996, "condition": 5.5},
+            "status": {"parameters": [{"parameter": "offset", "status": "identified"},
+                                      {"parameter": "angle", "status": "not identified", "reason": "K = 2"}]}
+        });
+        let r = row_from_identify(&report);
+        assert_eq!((r.offset_um, r.offset_se_um), (Some(7.9), Some(0.1)));
+        assert_eq!((r.angle_deg, r.angle_se_deg), (Some(-49.8), Some(1.2)));
+        assert_eq!(
+            (r.ktc_N_per_mm2, r.ktc_se_N_per_mm2),
+            (Some(1895.0), Some(38.0))
+        );
+        assert_eq!((r.kae_N_per_mm, r.kae_se_N_per_mm), (Some(-2.6), Some(0.4)));
+        assert_eq!(r.krc_N_per_mm2, None);
+        assert_eq!(
+            (r.r_squared, r.residual_rms_N, r.condition),
+            (Some(0.9996), Some(1.8), Some(5.5))
+        );
+        assert_eq!(r.time, "2026-11-25 07:10:00");
+        assert_eq!(r.verdict, "not identified: angle (K = 2)");
+        // no full-signal fit: the sine fit
+        let mut report = report;
+        report["full_signal"] = serde_json::Value::Null;
+        let r = row_from_identify(&report);
+        assert_eq!(
+            (r.offset_um, r.angle_deg, r.ktc_N_per_mm2),
+            (Some(6.0), Some(1.0), None)
+        );
+    }
 
     #[test]
     fn dates() {
