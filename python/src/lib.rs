@@ -504,7 +504,8 @@ fn range_policy(outside: &str) -> PyResult<runout_core::grind::RangePolicy> {
     )
 }
 
-/// Parse a CSV of numbers (header row, then rows) into named float64 columns.
+/// Parse a CSV of numbers (header row, then rows) into named float64 columns (`true`/`false`
+/// cells as 1/0).
 fn csv_columns(text: &str) -> anyhow::Result<(Vec<String>, Vec<Vec<f64>>)> {
     let mut lines = text.lines();
     let names: Vec<String> = lines
@@ -516,7 +517,11 @@ fn csv_columns(text: &str) -> anyhow::Result<(Vec<String>, Vec<Vec<f64>>)> {
     let mut cols = vec![Vec::new(); names.len()];
     for line in lines.filter(|l| !l.trim().is_empty()) {
         for (c, cell) in cols.iter_mut().zip(line.split(',')) {
-            c.push(cell.trim().parse::<f64>().unwrap_or(f64::NAN));
+            c.push(match cell.trim() {
+                "true" => 1.0,
+                "false" => 0.0,
+                t => t.parse::<f64>().unwrap_or(f64::NAN),
+            });
         }
     }
     Ok((names, cols))
