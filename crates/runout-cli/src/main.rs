@@ -36,6 +36,8 @@ enum Command {
     Grind(cmd::grind::Args),
     /// Cutting force and runout from two-point shank deflection (capacitive sensors).
     Shank(cmd::shank::Args),
+    /// Identify many recordings (folder or glob) in parallel into one summary table; resumable.
+    Batch(cmd::batch::Args),
     /// What a recording holds (.mat, TDMS, HDF5, Parquet, CSV): channels, units, lengths, rates.
     Inspect(cmd::inspect::Args),
 }
@@ -84,6 +86,7 @@ fn main() -> ExitCode {
         Command::Grind(a) => cmd::grind::run(a),
         Command::Shank(a) => cmd::shank::run(a),
         Command::Inspect(a) => cmd::inspect::run(a),
+        Command::Batch(a) => cmd::batch::run(a),
     };
     // outputs appear only when the whole command succeeded (or only its stdout was cut short)
     let result = match result {

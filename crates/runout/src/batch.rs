@@ -236,6 +236,7 @@ pub fn row_from_identify(report: &serde_json::Value) -> Row {
             row.offset_se_um = num(sf, "offset_um_se").or(num(sf, "offset_se_um"));
             row.angle_deg = num(sf, "angle_deg");
             row.angle_se_deg = num(sf, "angle_deg_se").or(num(sf, "angle_se_deg"));
+            row.r_squared = num(sf, "r_squared");
         }
     }
     // date/time stated in the header (DynoWare `Date`, `Time`, …)
