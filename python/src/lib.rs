@@ -816,6 +816,46 @@ fn chip_eval<'py>(
     Ok((to_dict(py, &r)?, d))
 }
 
+// ---------------------------------------------------------------------------------------------
+// keyword arguments as a settings layer (config keys, as in a TOML config)
+
+/// `**keys` as a settings layer over a config (numbers, strings, booleans, lists of numbers or
+/// strings — a list is what a TOML array is, e.g. `fz_mm=[0.05, 0.08]`); unknown keys are an
+/// error listing the known ones.
+fn layer(keys: Option<&Bound<'_, PyDict>>, known: &[&str]) -> PyResult<runout_io::config::Layer> {
+    use runout_io::config::{Layer, Value};
+    let mut values = std::collections::BTreeMap::new();
+    for (k, v) in keys.into_iter().flat_map(|d| d.iter()) {
+        let key: String = k.extract()?;
+        if !known.contains(&key.as_str()) {
+            return Err(RunoutError::new_err(format!(
+                "unknown keyword argument `{key}`; known keys: {}",
+                known.join(", ")
+            )));
+        }
+        let value = if v.is_instance_of::<pyo3::types::PyBool>() {
+            Value::Text(v.extract::<bool>()?.to_string())
+        } else if let Ok(x) = v.extract::<f64>() {
+            Value::Number(x)
+        } else if let Ok(t) = v.extract::<String>() {
+            Value::Text(t)
+        } else if let Ok(xs) = v.extract::<Vec<f64>>() {
+            Value::Text(xs.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(","))
+        } else if let Ok(ts) = v.extract::<Vec<String>>() {
+            Value::Text(ts.join(","))
+        } else {
+            return Err(PyTypeError::new_err(format!(
+                "keyword argument `{key}`: expected a number, a string, a bool or a list of them"
+            )));
+        };
+        values.insert(key, value);
+    }
+    Ok(Layer {
+        origin: "keyword arguments".into(),
+        values,
+    })
+}
+
 /// The native module.
 #[pymodule]
 fn _runout(m: &Bound<'_, PyModule>) -> PyResult<()> {

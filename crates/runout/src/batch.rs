@@ -105,7 +105,7 @@ pub struct BatchReport {
     pub analysed: usize,
     /// Of those, analysed successfully.
     pub ok: usize,
-    /// Of those, failed (each with its message).
+    /// Of those, failed (each with its message), sorted by file.
     pub failed: Vec<Failure>,
     /// Rows in the summary after the run.
     pub rows: usize,
@@ -174,17 +174,24 @@ pub fn read_summary(path: &Path) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
+/// The summary's columns, in order (the CSV header).
+pub fn columns() -> Vec<String> {
+    let mut probe = csv::Writer::from_writer(Vec::new());
+    probe.serialize(Row::default()).expect("a row serialises");
+    let bytes = probe.into_inner().unwrap_or_default();
+    let text = String::from_utf8_lossy(&bytes);
+    let header = text.lines().next().unwrap_or_default();
+    header.split(',').map(String::from).collect()
+}
+
+/// The summary's text columns (the others are numbers, empty when not available).
+pub const TEXT_COLUMNS: [&str; 5] = ["file", "status", "error", "time", "verdict"];
+
 /// Write `rows` as the summary CSV (header first).
 pub fn write_summary(w: impl std::io::Write, rows: &[Row]) -> Result<()> {
     if rows.is_empty() {
-        // the header alone: the first line of a serialised row
-        let mut probe = csv::Writer::from_writer(Vec::new());
-        probe.serialize(Row::default())?;
-        let bytes = probe.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?;
-        let header = bytes.split(|&b| b == b'\n').next().unwrap_or_default();
         let mut w = w;
-        w.write_all(header)?;
-        w.write_all(b"\n")?;
+        writeln!(w, "{}", columns().join(","))?;
         w.flush()?;
         return Ok(());
     }
@@ -200,7 +207,8 @@ pub fn write_summary(w: impl std::io::Write, rows: &[Row]) -> Result<()> {
 /// coefficients with their standard errors and the fit quality from the full-signal fit (the
 /// seed-003 sine fit of the first recording when there is no full-signal fit), the recording's
 /// date and time from its header when it states them, and as verdict `identified` or
-/// `not identified: <parameter> (<reason>), …` from the report's status.
+/// `not identified: <parameter> (<reason>), … (<why the fit is not trusted>)` from the report's
+/// status.
 pub fn row_from_identify(report: &serde_json::Value) -> Row {
     let num = |v: &serde_json::Value, k: &str| v.get(k).and_then(serde_json::Value::as_f64);
     let mut row = Row::default();
@@ -285,10 +293,22 @@ pub fn row_from_identify(report: &serde_json::Value) -> Row {
                 }
             }
         }
+        let why: Vec<&str> = report
+            .get("status")
+            .and_then(|s| s.get("fit"))
+            .and_then(|f| f.as_array())
+            .map(|f| f.iter().filter_map(|x| x.as_str()).collect())
+            .unwrap_or_default();
         row.verdict = if missing.is_empty() {
             "identified".into()
-        } else {
+        } else if why.is_empty() {
             format!("not identified: {}", missing.join(", "))
+        } else {
+            format!(
+                "not identified: {} ({})",
+                missing.join(", "),
+                why.join("; ")
+            )
         };
     }
     row
@@ -411,7 +431,7 @@ where
     }
     let elapsed_s = start.elapsed().as_secs_f64();
     let analysed = new_rows.len();
-    let failed: Vec<Failure> = new_rows
+    let mut failed: Vec<Failure> = new_rows
         .iter()
         .filter(|r| r.status == "error")
         .map(|r| Failure {
@@ -419,6 +439,7 @@ where
             error: r.error.clone(),
         })
         .collect();
+    failed.sort_by(|a, b| a.file.cmp(&b.file));
     let ok = analysed - failed.len();
     let mut all = existing;
     all.extend(new_rows);
@@ -516,6 +537,17 @@ mod tests {
             (r.offset_um, r.angle_deg, r.ktc_N_per_mm2),
             (Some(6.0), Some(1.0), None)
         );
+    }
+
+    #[test]
+    fn columns_are_the_header() {
+        let c = columns();
+        assert_eq!(c.len(), 24);
+        assert_eq!(&c[..4], ["file", "status", "error", "time"]);
+        assert!(TEXT_COLUMNS.iter().all(|t| c.iter().any(|x| x == t)));
+        let mut out = Vec::new();
+        write_summary(&mut out, &[]).unwrap();
+        assert_eq!(String::from_utf8(out).unwrap(), c.join(",") + "\n");
     }
 
     #[test]
