@@ -314,6 +314,26 @@ pub fn row_from_identify(report: &serde_json::Value) -> Row {
     row
 }
 
+/// The identify job on one recording as its summary row ([`row_from_identify`]), on one rayon
+/// thread: a batch runs recordings in parallel, and with one thread the full-signal fit sums in a
+/// fixed order, so the numbers equal `RAYON_NUM_THREADS=1 runout identify RECORDING` to the last
+/// digit whatever the machine. `config` and `flags` as for [`crate::identify::resolve`] (the
+/// config's `fz_mm` is one value). `Err` for a recording that cannot be identified; pass it to
+/// [`finish_row`] for the row.
+pub fn identify_row(
+    recording: crate::Source,
+    config: Option<&crate::Source>,
+    flags: runout_io::config::Layer,
+) -> Result<Row> {
+    let req = crate::identify::resolve(config, flags, vec![recording])?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .context("starting a worker thread")?;
+    let report = pool.install(|| crate::identify::recordings(&req, &mut crate::NoProgress))?;
+    Ok(row_from_identify(&serde_json::to_value(&report)?))
+}
+
 fn mtime_utc(path: &Path) -> String {
     let Ok(t) = std::fs::metadata(path).and_then(|m| m.modified()) else {
         return String::new();
@@ -393,25 +413,7 @@ where
     ));
     pool.install(|| {
         todo.par_iter().with_max_len(1).for_each(|path| {
-            let name = path.display().to_string();
-            let row = match analyse(path) {
-                Ok(mut r) => {
-                    r.file = name;
-                    r.status = "ok".into();
-                    r.error.clear();
-                    if r.time.is_empty() {
-                        r.time = mtime_utc(path);
-                    }
-                    r
-                }
-                Err(e) => Row {
-                    file: name,
-                    status: "error".into(),
-                    error: runout_io::report::chain_of(e.chain()),
-                    time: mtime_utc(path),
-                    ..Row::default()
-                },
-            };
+            let row = finish_row(&path.display().to_string(), Some(path), analyse(path));
             on_row(&row);
             let mut s = sink.lock().expect("not poisoned");
             let written = s.0.serialize(&row).and_then(|_| Ok(s.0.flush()?));
@@ -468,6 +470,31 @@ where
             0.0
         },
     })
+}
+
+/// The summary row of one analysis: `file` = `name`, `status` ok or error, the error's message
+/// (the error and its causes, as the CLI prints them), and `time` from the file's modification
+/// time (UTC) when the analysis found none (empty for a recording in memory, `path` = `None`).
+pub fn finish_row(name: &str, path: Option<&Path>, result: Result<Row>) -> Row {
+    let mtime = || path.map(mtime_utc).unwrap_or_default();
+    match result {
+        Ok(mut r) => {
+            r.file = name.into();
+            r.status = "ok".into();
+            r.error.clear();
+            if r.time.is_empty() {
+                r.time = mtime();
+            }
+            r
+        }
+        Err(e) => Row {
+            file: name.into(),
+            status: "error".into(),
+            error: runout_io::report::chain_of(e.chain()),
+            time: mtime(),
+            ..Row::default()
+        },
+    }
 }
 
 fn tmp_next_to(path: &Path) -> PathBuf {

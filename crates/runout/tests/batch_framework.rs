@@ -172,3 +172,42 @@ fn bad_requests_are_errors() {
     let e = format!("{:#}", batch::run(&req, analyse, &|_| {}).unwrap_err());
     assert!(e.contains("s.csv:2") && e.contains("batch summary"), "{e}");
 }
+
+#[test]
+fn identify_row_equals_the_identify_report() {
+    // the bundled example: one recording, its feed as a flag
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let rec = root.join("examples/identify/cut_fz0.08.txt");
+    let config = runout::Source::path(root.join("examples/identify/cut.toml"));
+    let flags = || runout::io::config::Layer {
+        origin: "command line".into(),
+        values: [("fz_mm".to_string(), runout::io::config::Value::Number(0.08))].into(),
+    };
+    let row = batch::identify_row(runout::Source::path(&rec), Some(&config), flags()).unwrap();
+    let req = runout::identify::resolve(Some(&config), flags(), vec![runout::Source::path(&rec)])
+        .unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let report = pool
+        .install(|| runout::identify::recordings(&req, &mut runout::NoProgress))
+        .unwrap();
+    let v = serde_json::to_value(&report).unwrap();
+    assert_eq!(row.offset_um, v["full_signal"]["offset_um"].as_f64());
+    assert_eq!(row.angle_se_deg, v["full_signal"]["angle_deg_se"].as_f64());
+    assert_eq!(
+        row.kae_se_N_per_mm,
+        v["full_signal"]["coefficients"]["kae_N_per_mm_se"].as_f64()
+    );
+    // the known runout of the example: 8 µm at −50° (examples/identify/README.md)
+    assert!((row.offset_um.unwrap() - 8.0).abs() < 0.5, "{row:?}");
+    assert!((row.angle_deg.unwrap() + 50.0).abs() < 5.0, "{row:?}");
+    // a bad recording: an error naming it
+    let bad = runout::Source::bytes("bad.txt", &b"Fx,Fy\n1,2\n"[..]);
+    let e = batch::identify_row(bad, Some(&config), flags()).unwrap_err();
+    let row = batch::finish_row("bad.txt", None, Err(e));
+    assert_eq!(row.status, "error");
+    assert!(row.error.contains("bad.txt"), "{}", row.error);
+    assert_eq!(row.time, "");
+}
