@@ -13,8 +13,15 @@ stiffness N/µm.
 """
 
 from ._runout import (  # noqa: F401
+    SUMMARY_COLUMNS,
+    SUMMARY_TEXT_COLUMNS,
     RunoutError,
     __version__,
+    batch,
+    batch_row,
+    identify,
+    identify_peaks,
+    identify_tests,
     chip_compare,
     chip_eval,
     displacement_heights,
@@ -28,7 +35,14 @@ from ._runout import (  # noqa: F401
 )
 
 __all__ = [
+    "SUMMARY_COLUMNS",
+    "SUMMARY_TEXT_COLUMNS",
     "RunoutError",
+    "batch",
+    "batch_row",
+    "identify",
+    "identify_peaks",
+    "identify_tests",
     "chip_compare",
     "chip_eval",
     "displacement_heights",

@@ -6,7 +6,7 @@ as ``(name, mapping)``. Reports are dicts with the CLI's ``--json`` field names 
 """
 
 import os
-from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -193,3 +193,67 @@ def chip_eval(
     Returns (``runout.chip.eval/1``, chips): ``time_s`` (s), ``spindle_angle_deg`` (deg),
     ``tooth`` (int64), ``z_mm`` (mm), ``h_mm`` (mm), one element per point.
     """
+
+SUMMARY_COLUMNS: List[str]
+"""Columns of the batch summary (``runout batch``'s CSV header, ``batch_row``'s keys)."""
+SUMMARY_TEXT_COLUMNS: List[str]
+"""The summary's text columns; the others are float (None / empty when not available)."""
+
+def identify(
+    recordings: Union[SourceLike, Sequence[SourceLike]],
+    config: Optional[SourceLike] = None,
+    **keys: Union[float, int, str, bool, Sequence[float], Sequence[str]],
+) -> Report:
+    """Runout ρ (µm), λ (deg) ± SE and the cutting coefficients (N/mm², N/mm) from force recordings.
+
+    ``recordings``: one source or a list (forces in N; arrays as ``{"Fx": …, "Fy": …, "Fz": …,
+    "fs": 10000.0}``); ``config``: cut.toml; ``keys``: config keys overriding it (``fz_mm`` (mm,
+    one per recording), ``teeth``, ``diameter_mm``, ``helix_deg``, ``rpm``, ``ap_mm``, ``ae_mm``,
+    ``mode``, ``axes``, ``sample_rate_hz`` (Hz), ``chain``, …). Returns
+    ``runout.identify.recording/1`` (the CLI's ``--json``).
+    """
+
+def identify_peaks(
+    peaks_N: ArrayLike,
+    *,
+    fz_mm: float,
+    peaks_se_N: Optional[ArrayLike] = None,
+    mode: str = "up",
+    ae_mm: Optional[float] = None,
+    diameter_mm: Optional[float] = None,
+    peak_immersion_deg: Optional[float] = None,
+    closed_period: bool = False,
+) -> Report:
+    """Seed-003 sine fit of per-tooth peaks (N). ``runout.identify.peaks/1``."""
+
+def identify_tests(
+    table: SourceLike,
+    *,
+    diameter_mm: Optional[float] = None,
+    ae_mm: Optional[float] = None,
+    mode: Optional[str] = None,
+    peak_immersion_deg: Optional[float] = None,
+    closed_period: bool = False,
+) -> Report:
+    """Several peak tests: per-test fits, regressions, K_T/K_R, pooled fit. ``runout.identify.tests/1``."""
+
+def batch_row(
+    recording: SourceLike,
+    config: Optional[SourceLike] = None,
+    **keys: Union[float, int, str, bool, Sequence[float], Sequence[str]],
+) -> Dict[str, Union[str, float, None]]:
+    """One recording identified, as its ``runout batch`` summary row (keys ``SUMMARY_COLUMNS``).
+
+    A recording that cannot be identified gives ``status="error"`` and the message (no exception).
+    """
+
+def batch(
+    inputs: Union[str, Sequence[str]],
+    config: SourceLike,
+    summary: Union[str, "os.PathLike[str]"],
+    *,
+    threads: Optional[int] = None,
+    retry_errors: bool = False,
+    **keys: Union[float, int, str, bool, Sequence[float], Sequence[str]],
+) -> Report:
+    """``runout batch`` in-process: folders / glob patterns / files → summary CSV. ``runout.batch/1``."""

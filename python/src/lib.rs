@@ -856,6 +856,207 @@ fn layer(keys: Option<&Bound<'_, PyDict>>, known: &[&str]) -> PyResult<runout_io
     })
 }
 
+// ---------------------------------------------------------------------------------------------
+// identify, simulate, batch
+
+/// A list of sources, or one source.
+fn sources(py: Python<'_>, obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<Source>> {
+    if obj.is_instance_of::<pyo3::types::PyList>() {
+        let mut v = Vec::new();
+        for (i, item) in obj.try_iter()?.enumerate() {
+            v.push(source(py, &item?, &format!("{what}[{i}]"))?);
+        }
+        return Ok(v);
+    }
+    Ok(vec![source(py, obj, what)?])
+}
+
+/// Runout offset ρ (µm) and angle λ (deg) with standard errors, and the six cutting coefficients
+/// (N/mm², N/mm), from force recordings (methods.md §4; the CLI's `runout identify`).
+///
+/// Args: recordings (a source or a list of sources: paths, bytes, or arrays such as
+/// `{"Fx": fx, "Fy": fy, "Fz": fz, "fs": 10000.0}` with forces in N and `fs` in Hz or a
+/// `time_s` array), config (cut.toml source, optional), and any config key as a keyword
+/// argument overriding the config (`fz_mm=[0.05, 0.08]` (mm, one per recording), `teeth`,
+/// `diameter_mm`, `helix_deg` (deg), `rpm`, `ap_mm`, `ae_mm`, `mode`, `axes`,
+/// `sample_rate_hz` (Hz), `chain`, …).
+/// Returns the `runout.identify.recording/1` report as a dict (`full_signal.offset_um`, …).
+#[pyfunction]
+#[pyo3(signature = (recordings, config=None, **keys))]
+fn identify<'py>(
+    py: Python<'py>,
+    recordings: &Bound<'py, PyAny>,
+    config: Option<&Bound<'py, PyAny>>,
+    keys: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let recs = sources(py, recordings, "recordings")?;
+    let config = opt_source(py, config, "config")?;
+    let flags = layer(keys, &runout_io::config::identify::identify_key_names())?;
+    let r = run(py, move || {
+        let req = runout::identify::resolve(config.as_ref(), flags, recs)?;
+        runout::identify::recordings(&req, &mut NoProgress)
+    })?;
+    to_dict(py, &r)
+}
+
+fn parse_mode(mode: &str) -> PyResult<runout_core::MillingMode> {
+    mode.parse()
+        .map_err(|e: <runout_core::MillingMode as std::str::FromStr>::Err| {
+            RunoutError::new_err(format!("mode: {e}"))
+        })
+}
+
+fn hypothesis(closed_period: bool) -> runout_core::identify::SineHypothesis {
+    if closed_period {
+        runout_core::identify::SineHypothesis::ClosedPeriod
+    } else {
+        runout_core::identify::SineHypothesis::Teeth
+    }
+}
+
+/// Seed-003 sine fit of one per-tooth peak table (methods.md §4.2): runout ρ (µm), λ (deg).
+///
+/// Args: peaks_N (per-tooth peak forces, N, teeth in cutting order), fz_mm (mm), peaks_se_N
+/// (N), mode (`up` | `down` | `slot`), ae_mm (mm), diameter_mm (mm), peak_immersion_deg (deg),
+/// closed_period (K + 1 points, the seed's Table 2).
+/// Returns the `runout.identify.peaks/1` report as a dict.
+#[pyfunction]
+#[pyo3(signature = (peaks_N, *, fz_mm, peaks_se_N=None, mode="up", ae_mm=None, diameter_mm=None, peak_immersion_deg=None, closed_period=false))]
+#[allow(non_snake_case, clippy::too_many_arguments)]
+fn identify_peaks<'py>(
+    py: Python<'py>,
+    peaks_N: &Bound<'py, PyAny>,
+    fz_mm: f64,
+    peaks_se_N: Option<&Bound<'py, PyAny>>,
+    mode: &str,
+    ae_mm: Option<f64>,
+    diameter_mm: Option<f64>,
+    peak_immersion_deg: Option<f64>,
+    closed_period: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let peaks = float_array(py, peaks_N, "peaks_N")?.to_vec();
+    let mut req = runout::identify::PeaksRequest::new(peaks, fz_mm);
+    req.peaks_se_N = peaks_se_N
+        .map(|a| float_array(py, a, "peaks_se_N").map(|v| v.to_vec()))
+        .transpose()?;
+    req.mode = parse_mode(mode)?;
+    req.ae_mm = ae_mm;
+    req.diameter_mm = diameter_mm;
+    req.peak_immersion_deg = peak_immersion_deg;
+    req.hypothesis = hypothesis(closed_period);
+    let r = run(py, || runout::identify::peaks(&req))?;
+    to_dict(py, &r)
+}
+
+/// Several peak tests (methods.md §4.6): per-test sine fits, regressions, K_T/K_R, pooled fit.
+///
+/// Args: table (source: CSV/TSV with `test, fz_mm, ap_mm, peak0_N…` or TOML `[[test]]` — a
+/// TOML given as bytes needs a `(name.toml, bytes)` pair), diameter_mm, ae_mm (mm), mode,
+/// peak_immersion_deg (deg): values the rows do not give; closed_period.
+/// Returns the `runout.identify.tests/1` report as a dict.
+#[pyfunction]
+#[pyo3(signature = (table, *, diameter_mm=None, ae_mm=None, mode=None, peak_immersion_deg=None, closed_period=false))]
+fn identify_tests<'py>(
+    py: Python<'py>,
+    table: &Bound<'py, PyAny>,
+    diameter_mm: Option<f64>,
+    ae_mm: Option<f64>,
+    mode: Option<&str>,
+    peak_immersion_deg: Option<f64>,
+    closed_period: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut req = runout::identify::TestsRequest::new(source(py, table, "table")?);
+    req.defaults = runout::identify::TestsDefaults {
+        diameter_mm,
+        ae_mm,
+        mode: mode.map(parse_mode).transpose()?,
+        peak_immersion_deg,
+    };
+    req.hypothesis = hypothesis(closed_period);
+    let r = run(py, || runout::identify::tests(&req))?;
+    to_dict(py, &r)
+}
+
+fn row_dict<'py>(py: Python<'py>, row: &runout::batch::Row) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(row).map_err(|e| RunoutError::new_err(e.to_string()))?;
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+/// One recording identified and reduced to its summary row — what `runout batch` writes for it
+/// (docs/batch.md; the function to map over files or byte blobs on Dask or Spark).
+///
+/// Args: recording (one source: path, bytes, `(name, bytes)`, arrays), config (cut.toml source),
+/// and config keys as keyword arguments (as for `identify`; `fz_mm` one value).
+/// Returns a dict with the columns `runout.SUMMARY_COLUMNS` (`file`, `status` ok | error,
+/// `error`, `time`, `offset_um`, `offset_se_um`, `angle_deg`, …; None when not available). A
+/// recording that cannot be identified gives `status = "error"` with the message (no exception);
+/// bad arguments or config keys raise `RunoutError`. Runs on one thread (parallelism across
+/// recordings), so the numbers equal `runout batch`'s to the last digit.
+#[pyfunction]
+#[pyo3(signature = (recording, config=None, **keys))]
+fn batch_row<'py>(
+    py: Python<'py>,
+    recording: &Bound<'py, PyAny>,
+    config: Option<&Bound<'py, PyAny>>,
+    keys: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let rec = source(py, recording, "recording")?;
+    let config = opt_source(py, config, "config")?;
+    let flags = layer(keys, &runout_io::config::identify::identify_key_names())?;
+    let row = py.detach(move || {
+        let name = rec.name().to_string();
+        let path = rec.as_path().map(|p| p.to_path_buf());
+        let result = runout::batch::identify_row(rec, config.as_ref(), flags);
+        runout::batch::finish_row(&name, path.as_deref(), result)
+    });
+    row_dict(py, &row)
+}
+
+/// `runout batch` from Python: identify every recording of `inputs` (folders, glob patterns,
+/// files) in parallel into the summary CSV `summary` (resumable; docs/batch.md).
+///
+/// Args: inputs (str or list of str), config (cut.toml path), summary (CSV path), threads
+/// (default the cores), retry_errors, and config keys as keyword arguments.
+/// Returns the `runout.batch/1` report as a dict (`analysed`, `ok`, `failed`, `recordings_per_s`…).
+#[pyfunction]
+#[pyo3(signature = (inputs, config, summary, *, threads=None, retry_errors=false, **keys))]
+fn batch<'py>(
+    py: Python<'py>,
+    inputs: &Bound<'py, PyAny>,
+    config: &Bound<'py, PyAny>,
+    summary: std::path::PathBuf,
+    threads: Option<usize>,
+    retry_errors: bool,
+    keys: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let specs: Vec<String> = match inputs.extract::<String>() {
+        Ok(s) => vec![s],
+        Err(_) => inputs.extract()?,
+    };
+    let config = source(py, config, "config")?;
+    let flags = layer(keys, &runout_io::config::identify::identify_key_names())?;
+    let r = run(py, move || {
+        let mut files = Vec::new();
+        for s in &specs {
+            files.extend(runout::batch::expand(s)?);
+        }
+        let req = runout::batch::BatchRequest {
+            files,
+            summary,
+            threads,
+            retry_errors,
+        };
+        runout::batch::run(
+            &req,
+            |p: &std::path::Path| {
+                runout::batch::identify_row(Source::path(p), Some(&config), flags.clone())
+            },
+            &|_| {},
+        )
+    })?;
+    to_dict(py, &r)
+}
+
 /// The native module.
 #[pymodule]
 fn _runout(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -871,5 +1072,15 @@ fn _runout(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(grind_check, m)?)?;
     m.add_function(wrap_pyfunction!(chip_compare, m)?)?;
     m.add_function(wrap_pyfunction!(chip_eval, m)?)?;
+    m.add_function(wrap_pyfunction!(identify, m)?)?;
+    m.add_function(wrap_pyfunction!(identify_peaks, m)?)?;
+    m.add_function(wrap_pyfunction!(identify_tests, m)?)?;
+    m.add_function(wrap_pyfunction!(batch_row, m)?)?;
+    m.add_function(wrap_pyfunction!(batch, m)?)?;
+    m.add("SUMMARY_COLUMNS", runout::batch::columns())?;
+    m.add(
+        "SUMMARY_TEXT_COLUMNS",
+        runout::batch::TEXT_COLUMNS.iter().map(|s| s.to_string()).collect::<Vec<_>>(),
+    )?;
     Ok(())
 }

@@ -314,23 +314,32 @@ pub fn row_from_identify(report: &serde_json::Value) -> Row {
     row
 }
 
-/// The identify job on one recording as its summary row ([`row_from_identify`]), on one rayon
-/// thread: a batch runs recordings in parallel, and with one thread the full-signal fit sums in a
-/// fixed order, so the numbers equal `RAYON_NUM_THREADS=1 runout identify RECORDING` to the last
-/// digit whatever the machine. `config` and `flags` as for [`crate::identify::resolve`] (the
-/// config's `fz_mm` is one value). `Err` for a recording that cannot be identified; pass it to
-/// [`finish_row`] for the row.
+/// The identify job on one recording as its summary row ([`row_from_identify`]). `config` and
+/// `flags` as for [`crate::identify::resolve`] (the config's `fz_mm` is one value). `Err` for a
+/// recording that cannot be identified; pass it to [`finish_row`] for the row.
+///
+/// Threads: called from a worker of a rayon pool (the in-process [`run`]), the job runs on a
+/// pool of its own with one thread — a batch is parallel across recordings, and this keeps the
+/// workers from sharing each other's pool. Called from any other thread (a Dask or Spark task,
+/// a Python thread), it runs on rayon's global pool, exactly as `runout identify` does; with
+/// `RAYON_NUM_THREADS=1` the full-signal fit then sums in a fixed order and the numbers equal
+/// `RAYON_NUM_THREADS=1 runout identify RECORDING` (and `runout batch`) to the last digit.
 pub fn identify_row(
     recording: crate::Source,
     config: Option<&crate::Source>,
     flags: runout_io::config::Layer,
 ) -> Result<Row> {
     let req = crate::identify::resolve(config, flags, vec![recording])?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .context("starting a worker thread")?;
-    let report = pool.install(|| crate::identify::recordings(&req, &mut crate::NoProgress))?;
+    let job = || crate::identify::recordings(&req, &mut crate::NoProgress);
+    let report = if rayon::current_thread_index().is_some() {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .context("starting a worker thread")?
+            .install(job)?
+    } else {
+        job()?
+    };
     Ok(row_from_identify(&serde_json::to_value(&report)?))
 }
 
