@@ -71,7 +71,11 @@ fn float_array(py: Python<'_>, obj: &Bound<'_, PyAny>, what: &str) -> PyResult<A
 }
 
 /// Named arrays from a mapping (`dict`, pandas `DataFrame`: anything with `.items()`).
-fn arrays(py: Python<'_>, obj: &Bound<'_, PyAny>, what: &str) -> PyResult<runout_io::formats::Arrays> {
+fn arrays(
+    py: Python<'_>,
+    obj: &Bound<'_, PyAny>,
+    what: &str,
+) -> PyResult<runout_io::formats::Arrays> {
     let mut columns = Vec::new();
     for item in obj.call_method0("items")?.try_iter()? {
         let item = item?;
@@ -100,17 +104,23 @@ fn source(py: Python<'_>, obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Source
         return named_source(py, format!("<{what}>"), obj, what);
     }
     let os = py.import("os")?;
-    let path = os.call_method1("fspath", (obj,)).map_err(|_| {
-        PyTypeError::new_err(format!(
+    let path =
+        os.call_method1("fspath", (obj,)).map_err(|_| {
+            PyTypeError::new_err(format!(
             "{what}: expected a path, bytes, a (name, bytes) pair or a mapping of arrays, got {}",
             obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
         ))
-    })?;
+        })?;
     let path: std::path::PathBuf = path.extract()?;
     Ok(Source::path(path))
 }
 
-fn named_source(py: Python<'_>, name: String, obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Source> {
+fn named_source(
+    py: Python<'_>,
+    name: String,
+    obj: &Bound<'_, PyAny>,
+    what: &str,
+) -> PyResult<Source> {
     if let Ok(b) = obj.cast::<PyBytes>() {
         return Ok(Source::bytes(name, b.as_bytes().to_vec()));
     }
@@ -122,7 +132,11 @@ fn named_source(py: Python<'_>, name: String, obj: &Bound<'_, PyAny>, what: &str
     )))
 }
 
-fn opt_source(py: Python<'_>, obj: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Option<Source>> {
+fn opt_source(
+    py: Python<'_>,
+    obj: Option<&Bound<'_, PyAny>>,
+    what: &str,
+) -> PyResult<Option<Source>> {
     obj.map(|o| source(py, o, what)).transpose()
 }
 
@@ -292,7 +306,11 @@ fn shank_calibrate<'py>(
 // ---------------------------------------------------------------------------------------------
 // displacement
 
-fn cutter(teeth: Option<usize>, diameter_mm: Option<f64>, helix_deg: f64) -> PyResult<Option<runout_core::Cutter>> {
+fn cutter(
+    teeth: Option<usize>,
+    diameter_mm: Option<f64>,
+    helix_deg: f64,
+) -> PyResult<Option<runout_core::Cutter>> {
     match (teeth, diameter_mm) {
         (Some(k), Some(d)) => runout_core::Cutter::flat(d, k, helix_deg)
             .map(Some)
@@ -302,12 +320,19 @@ fn cutter(teeth: Option<usize>, diameter_mm: Option<f64>, helix_deg: f64) -> PyR
     }
 }
 
-fn sensor(sensor: &str, inclination_deg: f64, beam_offset_mm: f64) -> PyResult<runout::displacement::Sensor> {
+fn sensor(
+    sensor: &str,
+    inclination_deg: f64,
+    beam_offset_mm: f64,
+) -> PyResult<runout::displacement::Sensor> {
     use runout_core::displacement::{BeamGeometry, SensorSign};
     let sign = choice(
         "sensor",
         sensor,
-        &[("distance", SensorSign::Distance), ("radial", SensorSign::Radial)],
+        &[
+            ("distance", SensorSign::Distance),
+            ("radial", SensorSign::Radial),
+        ],
     )?;
     let beam = BeamGeometry::new(inclination_deg.to_radians(), beam_offset_mm)
         .map_err(|e| RunoutError::new_err(e.to_string()))?;
@@ -352,7 +377,10 @@ fn displacement_teeth<'py>(
     opts.method = choice(
         "method",
         method,
-        &[("joint", ToothMethod::Joint), ("scan", ToothMethod::SeedScan)],
+        &[
+            ("joint", ToothMethod::Joint),
+            ("scan", ToothMethod::SeedScan),
+        ],
     )?;
     opts.known_offset_mm = offset_um.map(|x| x * 1e-3);
     opts.known_offset_se_mm = offset_se_um.map(|x| x * 1e-3);
@@ -390,7 +418,10 @@ fn displacement_heights<'py>(
         method: choice(
             "method",
             method,
-            &[("ols", HeightRegression::Ols), ("eq6", HeightRegression::SeedEq6)],
+            &[
+                ("ols", HeightRegression::Ols),
+                ("eq6", HeightRegression::SeedEq6),
+            ],
         )?,
     };
     let r = run(py, || runout::displacement::heights(&req))?;
@@ -500,7 +531,10 @@ fn range_policy(outside: &str) -> PyResult<runout_core::grind::RangePolicy> {
     choice(
         "outside",
         outside,
-        &[("clamp", RangePolicy::Clamp), ("extrapolate", RangePolicy::Extrapolate)],
+        &[
+            ("clamp", RangePolicy::Clamp),
+            ("extrapolate", RangePolicy::Extrapolate),
+        ],
     )
 }
 
@@ -633,18 +667,27 @@ fn grind_compensate<'py>(
             duplicates: choice(
                 "duplicates",
                 duplicates,
-                &[("error", DuplicatePolicy::Error), ("average", DuplicatePolicy::Average)],
+                &[
+                    ("error", DuplicatePolicy::Error),
+                    ("average", DuplicatePolicy::Average),
+                ],
             )?,
             missing: choice(
                 "missing",
                 missing,
-                &[("error", MissingPolicy::Error), ("skip", MissingPolicy::Skip)],
+                &[
+                    ("error", MissingPolicy::Error),
+                    ("skip", MissingPolicy::Skip),
+                ],
             )?,
         },
         scheme: choice(
             "scheme",
             scheme,
-            &[("first-harmonic", Scheme::FirstHarmonic), ("bilinear", Scheme::Bilinear)],
+            &[
+                ("first-harmonic", Scheme::FirstHarmonic),
+                ("bilinear", Scheme::Bilinear),
+            ],
         )?,
         range: range_policy(outside)?,
         edge,
@@ -658,7 +701,11 @@ fn grind_compensate<'py>(
         Ok((r, path))
     })?;
     let nc_text = r.detail.nc_text.clone();
-    Ok((to_dict(py, &r)?, columns_dict(py, &path.0, path.1)?, nc_text))
+    Ok((
+        to_dict(py, &r)?,
+        columns_dict(py, &path.0, path.1)?,
+        nc_text,
+    ))
 }
 
 /// The simulation check of the grinding compensation (methods.md §5.5): a bar with a known
@@ -694,7 +741,11 @@ fn grind_check<'py>(
     points_per_flute: usize,
     edge_phase_deg: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let ball = choice("edge (the check generates its edge)", edge, &[("flat", false), ("ball", true)])?;
+    let ball = choice(
+        "edge (the check generates its edge)",
+        edge,
+        &[("flat", false), ("ball", true)],
+    )?;
     let req = runout::grind::CheckRequest {
         bar_diameter_mm,
         offset_um: [offset_um.0, offset_um.1],
@@ -840,7 +891,12 @@ fn layer(keys: Option<&Bound<'_, PyDict>>, known: &[&str]) -> PyResult<runout_io
         } else if let Ok(t) = v.extract::<String>() {
             Value::Text(t)
         } else if let Ok(xs) = v.extract::<Vec<f64>>() {
-            Value::Text(xs.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(","))
+            Value::Text(
+                xs.iter()
+                    .map(|x| x.to_string())
+                    .collect::<Vec<_>>()
+                    .join(","),
+            )
         } else if let Ok(ts) = v.extract::<Vec<String>>() {
             Value::Text(ts.join(","))
         } else {
@@ -1080,7 +1136,10 @@ fn _runout(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SUMMARY_COLUMNS", runout::batch::columns())?;
     m.add(
         "SUMMARY_TEXT_COLUMNS",
-        runout::batch::TEXT_COLUMNS.iter().map(|s| s.to_string()).collect::<Vec<_>>(),
+        runout::batch::TEXT_COLUMNS
+            .iter()
+            .map(|s| s.to_string())
+            .collect::<Vec<_>>(),
     )?;
     Ok(())
 }
