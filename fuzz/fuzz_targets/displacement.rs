@@ -28,7 +28,7 @@ fuzz_target!(|data: &[u8]| {
         if let Ok(t) = read_tooth_table(path, teeth) {
             assert!(t.readings.iter().all(|(k, v)| *k < teeth && v.is_finite()));
             if let Ok(r) = ToothReadings::new(teeth, &t.readings, SensorSign::Radial) {
-                let cutter = Cutter::flat(10.0, teeth, 30.0).unwrap();
+                let cutter = Cutter::flat(10.0, teeth, 30.0f64.to_radians()).unwrap();
                 let _ = identify_from_teeth(&r, &ToothFitOptions::new(cutter));
             }
         }

@@ -36,7 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     };
-    let cutter = Cutter::flat(8.0, 3, 30.0)?;
+    let cutter = Cutter::flat(8.0, 3, 30.0f64.to_radians())?;
     let runout = Runout::new(0.010, 30f64.to_radians())?;
     let c = Cut::new(3000.0, 0.05, 2.0)?.radial(2.0, MillingMode::Down, &cutter)?;
     let coefficients = CuttingCoefficients::new([1889.2, 806.1, 291.0], [63.12, 113.7, -3.1])?;

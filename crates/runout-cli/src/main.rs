@@ -2,6 +2,7 @@
 //! (model and methods) and `runout-io` (formats): parse arguments, read, call, write.
 
 mod cmd;
+mod flags;
 mod output;
 mod progress;
 

@@ -29,7 +29,7 @@ fn recording(dir: &Path, name: &str, fz: f64, lambda_deg: f64, revs: f64, seed: 
     let cutter = Cutter::new(
         6.0,
         vec![std::f64::consts::TAU / 3.0; 3],
-        30.0,
+        30.0f64.to_radians(),
         f64::INFINITY,
         RadiusProfile::Ball,
     )

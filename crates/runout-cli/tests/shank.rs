@@ -185,7 +185,7 @@ fn synthetic_random(
     chain: runout_core::chain::MeasuringChain,
     random_n: f64,
 ) -> (Vec<Vec<f64>>, (usize, usize)) {
-    let cutter = Cutter::flat(8.0, 3, 30.0).unwrap();
+    let cutter = Cutter::flat(8.0, 3, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.010, 0.5).unwrap();
     let c = Cut::new(3000.0, 0.05, 2.0)
         .unwrap()

@@ -131,6 +131,19 @@ fn simulate() {
     ));
 }
 
+#[test]
+fn inspect() {
+    let d = tmp();
+    insta::assert_snapshot!(run(
+        &[
+            "inspect",
+            "--json",
+            "crates/runout-io/tests/fixtures/tdms_writer.tdms"
+        ],
+        d.path()
+    ));
+}
+
 /// `chip compare` measures throughput on the wall clock: that one object is redacted.
 fn without_throughput(text: &str) -> String {
     let mut out = String::new();
@@ -297,7 +310,7 @@ fn shank_stiffness() {
 fn shank_recording(path: &Path) {
     use runout_core::shank::{ShankBeam, SyntheticShank};
     use runout_core::*;
-    let cutter = Cutter::flat(8.0, 3, 30.0).unwrap();
+    let cutter = Cutter::flat(8.0, 3, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.010, 0.5).unwrap();
     let c = Cut::new(3000.0, 0.05, 2.0)
         .unwrap()

@@ -34,7 +34,7 @@ fn thread_cpu_ns() -> u64 {
 }
 
 fn kin(motion: Motion) -> ToolKinematics<Motion> {
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.010, 40f64.to_radians()).unwrap();
     ToolKinematics::new(
         &cutter,
@@ -133,7 +133,7 @@ fn trait_bench<T: Measurement, C: ChipThickness>(g: &mut BenchmarkGroup<'_, T>, 
 }
 
 fn trait_models() -> (ExactChip, EquivalentChip, ArcChip) {
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.010, 40f64.to_radians()).unwrap();
     (
         ExactChip::new(&cutter, &runout, 0.1).unwrap(),

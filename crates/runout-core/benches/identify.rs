@@ -29,7 +29,7 @@ use runout_core::*;
 /// K 4, D 10, helix 30°, down-milling a_e 3, a_p 2, f_z 0.08, ρ 8 µm at 30°; 20 revolutions at
 /// 1°, 2 % noise, averaged → one revolution of F_x, F_y, F_z (360 samples each).
 fn case() -> (WaveformCase, ForceModel, ArcChip, Sampling) {
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.008, 30f64.to_radians()).unwrap();
     let cut = Cut::new(3000.0, 0.08, 2.0)
         .unwrap()
@@ -53,9 +53,12 @@ fn case() -> (WaveformCase, ForceModel, ArcChip, Sampling) {
         v.iter().map(|x| x + n.sample(&mut rng)).collect()
     };
     let (x, y, z) = (noisy(&s.fx), noisy(&s.fy), noisy(&s.fz));
-    let waveform =
-        AveragedWaveform::average(0.0, 360, &[(Axis::X, &x), (Axis::Y, &y), (Axis::Z, &z)])
-            .unwrap();
+    let waveform = AveragedWaveform::average(
+        0.0,
+        360,
+        &[(FrameAxis::X, &x), (FrameAxis::Y, &y), (FrameAxis::Z, &z)],
+    )
+    .unwrap();
     (
         WaveformCase {
             cutter,
@@ -111,7 +114,7 @@ fn chain_cases() -> Vec<WaveformCase> {
         y: AxisChain::Modes(vec![mode]),
         z: AxisChain::Rigid,
     };
-    let cutter = Cutter::flat(20.0, 2, 40.0).unwrap();
+    let cutter = Cutter::flat(20.0, 2, 40.0f64.to_radians()).unwrap();
     let n = 96; // 12 kHz at 7500 rpm
     let lag_deg = (4.0 * 40f64.to_radians().tan() / 10.0).to_degrees();
     let disks = (lag_deg / 0.05).ceil() as usize;
@@ -145,7 +148,7 @@ fn chain_cases() -> Vec<WaveformCase> {
             );
             let mut rng = StdRng::seed_from_u64(11 + i as u64);
             let white = Normal::new(0.0, 1.0).unwrap();
-            let mut channel = |v: &[f64], axis: Axis| -> Vec<f64> {
+            let mut channel = |v: &[f64], axis: FrameAxis| -> Vec<f64> {
                 let kept: Vec<f64> = chain
                     .axis(axis)
                     .filter(12_000.0 * OVERSAMPLE as f64, v)
@@ -163,12 +166,16 @@ fn chain_cases() -> Vec<WaveformCase> {
                     })
                     .collect()
             };
-            let (fx, fy) = (channel(&s.fx, Axis::X), channel(&s.fy, Axis::Y));
+            let (fx, fy) = (channel(&s.fx, FrameAxis::X), channel(&s.fy, FrameAxis::Y));
             WaveformCase {
                 cutter: cutter.clone(),
                 cut,
-                waveform: AveragedWaveform::average(0.0, n, &[(Axis::X, &fx), (Axis::Y, &fy)])
-                    .unwrap(),
+                waveform: AveragedWaveform::average(
+                    0.0,
+                    n,
+                    &[(FrameAxis::X, &fx), (FrameAxis::Y, &fy)],
+                )
+                .unwrap(),
             }
         })
         .collect()
@@ -179,7 +186,7 @@ fn bench_chain(c: &mut Criterion) {
     let fitted = FullSignalOptions {
         chain: Some(ChainOptions {
             model: ChainModel::FitModes {
-                axes: vec![(Axis::X, None), (Axis::Y, None)],
+                axes: vec![(FrameAxis::X, None), (FrameAxis::Y, None)],
                 fit_gain: false,
             },
             spindle_hz: vec![125.0; 5],

@@ -30,7 +30,7 @@ struct Buffers {
 }
 
 fn buffers() -> Buffers {
-    let cutter = Cutter::flat(10.0, 3, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 3, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.010, 0.7).unwrap();
     let cut = Cut::new(RPM, 0.06, 2.0)
         .unwrap()

@@ -29,7 +29,7 @@
 //! ```
 
 use crate::error::ParamError;
-use crate::identify::Axis;
+use crate::identify::FrameAxis;
 use nalgebra::{Matrix2, Matrix4, Vector2};
 pub use realfft::num_complex::Complex64;
 use serde::Serialize;
@@ -332,11 +332,11 @@ pub struct MeasuringChain {
 
 impl MeasuringChain {
     /// The chain of `axis`.
-    pub fn axis(&self, axis: Axis) -> &AxisChain {
+    pub fn axis(&self, axis: FrameAxis) -> &AxisChain {
         match axis {
-            Axis::X => &self.x,
-            Axis::Y => &self.y,
-            Axis::Z => &self.z,
+            FrameAxis::X => &self.x,
+            FrameAxis::Y => &self.y,
+            FrameAxis::Z => &self.z,
         }
     }
 

@@ -51,7 +51,7 @@ pub enum FluteLead {
 ///
 /// ```
 /// use runout_core::Cutter;
-/// let c = Cutter::flat(10.0, 4, 30.0).unwrap();
+/// let c = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
 /// assert_eq!(c.teeth(), 4);
 /// assert!((c.radius() - 5.0).abs() < 1e-15);
 /// // tooth 1 of a uniform 4-tooth cutter sits at −90° at the tip
@@ -71,25 +71,28 @@ pub struct Cutter {
 }
 
 impl Cutter {
-    /// Flat end mill with uniform pitch; `helix_deg` is the helix angle (0 for straight flutes).
-    pub fn flat(diameter_mm: f64, teeth: usize, helix_deg: f64) -> Result<Self, ParamError> {
+    /// Flat end mill with uniform pitch; `helix_rad` is the helix angle in radians (0 for
+    /// straight flutes; conventions.md: radians inside the library, degrees at the interface).
+    pub fn flat(diameter_mm: f64, teeth: usize, helix_rad: f64) -> Result<Self, ParamError> {
         crate::limits::teeth("teeth", teeth)?;
         let pitch = vec![TAU / teeth as f64; teeth];
         Self::new(
             diameter_mm,
             pitch,
-            helix_deg,
+            helix_rad,
             f64::INFINITY,
             RadiusProfile::Flat,
         )
     }
 
-    /// General cutter. `pitch_rad[q]` is the angle from tooth q to tooth q+1 (cyclic), summing to 2π.
+    /// General cutter. `pitch_rad[q]` is the angle from tooth q to tooth q+1 (cyclic), summing to 2π;
+    /// `helix_rad` is the helix angle, |β| ≤ 89° (both in radians, conventions.md). Errors name
+    /// the interface keys (`pitch_deg`, `helix_deg`) with the values in degrees.
     /// `flute_length_mm` may be infinite (unbounded).
     pub fn new(
         diameter_mm: f64,
         pitch_rad: Vec<f64>,
-        helix_deg: f64,
+        helix_rad: f64,
         flute_length_mm: f64,
         profile: RadiusProfile,
     ) -> Result<Self, ParamError> {
@@ -112,12 +115,12 @@ impl Cutter {
                 format!("sum {:.6}°", sum.to_degrees()),
             ));
         }
-        let helix = finite("helix_deg", helix_deg)?;
-        if !(-89.0..=89.0).contains(&helix) {
+        let helix = finite("helix_deg", helix_rad)?;
+        if helix.abs() > 89f64.to_radians() {
             return Err(ParamError::new(
                 "helix_deg",
                 "a helix angle in [-89°, 89°]",
-                helix,
+                helix.to_degrees(),
             ));
         }
         if flute_length_mm.is_nan() || flute_length_mm <= 0.0 {
@@ -159,8 +162,8 @@ impl Cutter {
             radius,
             pitch: pitch_rad,
             tip_angles,
-            tan_helix: helix.to_radians().tan(),
-            helix: helix.to_radians(),
+            tan_helix: helix.tan(),
+            helix,
             flute_length: flute_length_mm,
             profile,
             lead: FluteLead::ConstantLead,
@@ -288,7 +291,7 @@ impl Cutter {
     ///
     /// ```
     /// use runout_core::{Cutter, RadiusProfile};
-    /// let c = Cutter::flat(10.0, 4, 30.0).unwrap();
+    /// let c = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     /// assert!((c.lag_slope(2.0) - 30f64.to_radians().tan() / 5.0).abs() < 1e-15);
     /// ```
     pub fn lag_slope(&self, z: f64) -> f64 {
@@ -308,7 +311,7 @@ impl Cutter {
     ///
     /// ```
     /// use runout_core::{Cutter, RadiusProfile};
-    /// let ball = Cutter::new(6.0, vec![std::f64::consts::TAU / 3.0; 3], 30.0, 20.0, RadiusProfile::Ball).unwrap();
+    /// let ball = Cutter::new(6.0, vec![std::f64::consts::TAU / 3.0; 3], 30.0f64.to_radians(), 20.0, RadiusProfile::Ball).unwrap();
     /// // at z = R/2 the sphere's normal is 60° from the axis
     /// assert!((ball.lead_angle(1.5).to_degrees() - 60.0).abs() < 1e-9);
     /// ```

@@ -1,8 +1,8 @@
 //! One per-disk edge geometry and engagement table for every force kernel (issue 12).
 //!
 //! Both [`crate::ForceModel::simulate`] and [`crate::identify::RevolutionModel`] consume an
-//! [`EdgeTable`]: a change of the cutter model (profile, lead angle, engagement) happens here
-//! and only here.
+//! [`EdgeTable`], through one shared kernel (`force::kernel`, issue 18): a change of the cutter
+//! model (profile, lead angle, engagement) happens here and only here.
 //!
 //! Discretisation (Engin & Altintas 2001, "Mechanics and dynamics of general milling cutters,
 //! Part I: helical end mills", Int. J. Mach. Tools Manuf. 41, §2–3; Lee & Altintas 1996,
@@ -46,12 +46,12 @@ use crate::cutter::Cutter;
 ///
 /// ```
 /// use runout_core::{edge::min_disks, Cut, Cutter, MillingMode, RadiusProfile};
-/// let ball = Cutter::new(6.0, vec![std::f64::consts::TAU / 3.0; 3], 30.0, 20.0, RadiusProfile::Ball).unwrap();
+/// let ball = Cutter::new(6.0, vec![std::f64::consts::TAU / 3.0; 3], 30.0f64.to_radians(), 20.0, RadiusProfile::Ball).unwrap();
 /// let cut = Cut::new(10400.0, 0.05, 0.2).unwrap().radial(0.125, MillingMode::Down, &ball).unwrap();
 /// // κ(0.2 mm) = 21.0°, but the window sweeps from 180° (slot at the tip) to 27.9°: 1522 disks
 /// let n = min_disks(&ball, &cut);
 /// assert!(n > 1500 && n < 1540, "{n}");
-/// assert_eq!(min_disks(&Cutter::flat(6.0, 3, 30.0).unwrap(), &cut), 1);
+/// assert_eq!(min_disks(&Cutter::flat(6.0, 3, 30.0f64.to_radians()).unwrap(), &cut), 1);
 /// ```
 pub fn min_disks(cutter: &Cutter, cut: &Cut) -> usize {
     let ap = cut.ap();
@@ -125,7 +125,7 @@ impl EdgeTable {
     ///
     /// ```
     /// use runout_core::{edge::EdgeTable, Cut, Cutter, MillingMode, RadiusProfile};
-    /// let ball = Cutter::new(6.0, vec![std::f64::consts::TAU / 3.0; 3], 30.0, 20.0, RadiusProfile::Ball).unwrap();
+    /// let ball = Cutter::new(6.0, vec![std::f64::consts::TAU / 3.0; 3], 30.0f64.to_radians(), 20.0, RadiusProfile::Ball).unwrap();
     /// let cut = Cut::new(10400.0, 0.05, 0.2).unwrap().radial(0.125, MillingMode::Down, &ball).unwrap();
     /// let t = EdgeTable::new(&ball, &cut, 4);
     /// let top = t.disk(3);

@@ -6,7 +6,7 @@ use thiserror::Error;
 ///
 /// ```
 /// use runout_core::Cutter;
-/// let err = Cutter::flat(-1.0, 4, 30.0).unwrap_err();
+/// let err = Cutter::flat(-1.0, 4, 30.0f64.to_radians()).unwrap_err();
 /// assert!(err.to_string().contains("diameter_mm"));
 /// ```
 #[derive(Debug, Clone, PartialEq, Error)]

@@ -10,7 +10,7 @@
 //!
 //! ```
 //! use runout_core::*;
-//! let cutter = Cutter::flat(10.0, 4, 30.0)?;
+//! let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians())?;
 //! let runout = Runout::new(0.008, 0.0)?;
 //! let r0 = runout.tooth_radius(&cutter, 0, 0.0);
 //! assert!((r0 - 5.008).abs() < 1e-9);
@@ -27,6 +27,8 @@ pub mod cutter;
 pub mod displacement;
 pub mod edge;
 pub mod error;
+pub mod estimate;
+pub mod fit;
 pub mod force;
 pub mod grind;
 pub mod identify;
@@ -41,5 +43,6 @@ pub use coefficients::CuttingCoefficients;
 pub use cut::{Cut, Engagement, MillingMode};
 pub use cutter::{Cutter, FluteLead, RadiusProfile};
 pub use error::ParamError;
+pub use estimate::Estimate;
 pub use force::{tooth_peaks, ForceModel, ForceSeries, Sampling, ToothPeak};
 pub use runout::Runout;

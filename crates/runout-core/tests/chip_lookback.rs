@@ -13,7 +13,7 @@ use runout_core::chip::*;
 use runout_core::{Cutter, Runout};
 
 fn kin(teeth: usize, rho_um: f64, rpm: f64, motion: Motion) -> ToolKinematics<Motion> {
-    let cutter = Cutter::flat(10.0, teeth, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, teeth, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(rho_um * 1e-3, 40f64.to_radians()).unwrap();
     ToolKinematics::new(&cutter, &runout, rpm, 0.3, SpindleSense::Clockwise, motion).unwrap()
 }

@@ -25,7 +25,7 @@ fn eq27(f: f64, r: f64, k: usize, phi: f64) -> f64 {
 
 #[test]
 fn no_runout_tends_to_fz_sin_phi() {
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     for f in [0.05, 0.005, 0.0005] {
         let exact = ExactChip::new(&cutter, &Runout::none(), f).unwrap();
         for q in 1..36 {
@@ -69,7 +69,7 @@ fn straight_kin(cutter: &Cutter, runout: &Runout, fz: f64) -> ToolKinematics<Str
 
 #[test]
 fn constant_axis_cl_path_equals_3axis() {
-    let cutter = Cutter::flat(8.0, 3, 35.0).unwrap();
+    let cutter = Cutter::flat(8.0, 3, 35.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.012, deg(-70.0))
         .unwrap()
         .with_tilt(2e-4, deg(20.0))
@@ -170,7 +170,7 @@ fn pure_swing_about_tip_is_linear_in_height() {
 
 #[test]
 fn trait_arc_agrees_with_3d_arc() {
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     for rho in [0.0, 0.010] {
         let runout = Runout::new(rho, deg(40.0)).unwrap();
         let fz = 0.1;
@@ -198,7 +198,7 @@ fn trait_arc_agrees_with_3d_arc() {
 
 #[test]
 fn exact_approaches_arc_for_tiny_feed() {
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.003, deg(10.0)).unwrap();
     let fz = 1e-4; // f/R = 2e-5
     let exact = ExactChip::new(&cutter, &runout, fz).unwrap();
@@ -222,7 +222,7 @@ fn equivalent_trait_equals_general_model() {
     let cutter = Cutter::new(
         12.0,
         vec![deg(80.0), deg(100.0), deg(80.0), deg(100.0)],
-        40.0,
+        40.0f64.to_radians(),
         30.0,
         RadiusProfile::Flat,
     )
@@ -256,7 +256,7 @@ fn equivalent_trait_equals_general_model() {
 
 #[test]
 fn fitted_compensation_improves_on_analytic() {
-    let cutter = Cutter::flat(6.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(6.0, 4, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.010, deg(40.0)).unwrap();
     let kin = straight_kin(&cutter, &runout, 0.2);
     let calib = calibration_grid(&kin, &[3.0], 24, 0.0);
@@ -280,7 +280,7 @@ fn fitted_compensation_improves_on_analytic() {
 
 #[test]
 fn fit_rejects_too_few_points() {
-    let cutter = Cutter::flat(6.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(6.0, 4, 30.0f64.to_radians()).unwrap();
     let kin = straight_kin(&cutter, &Runout::none(), 0.1);
     let err = fit_compensation(&kin, &calibration_grid(&kin, &[1.0], 0, 0.0), true).unwrap_err();
     assert!(err.param.contains("calibration_points"));
@@ -335,7 +335,7 @@ proptest! {
     ) {
         let tooth = tooth_sel % k;
         let fz = fz_rel * r;
-        let cutter = Cutter::flat(2.0 * r, k, helix).unwrap();
+        let cutter = Cutter::flat(2.0 * r, k, f64::to_radians(helix)).unwrap();
         let runout = Runout::new(rho_um * 1e-3, deg(lam)).unwrap();
         let kin = straight_kin(&cutter, &runout, fz);
         let t = kin.time_at_tooth_angle(tooth, z, deg(phi));
@@ -380,11 +380,18 @@ fn straight_feed_exact_solvers_agree_on_general_cutters() {
     // scalar exact (trait path) vs 3-D Newton: variable pitch, tilt, ball / bull-nose profiles
     let pitch = vec![deg(85.0), deg(95.0), deg(85.0), deg(95.0)];
     let cutters = [
-        Cutter::new(10.0, pitch.clone(), 35.0, 30.0, RadiusProfile::Ball).unwrap(),
+        Cutter::new(
+            10.0,
+            pitch.clone(),
+            35.0f64.to_radians(),
+            30.0,
+            RadiusProfile::Ball,
+        )
+        .unwrap(),
         Cutter::new(
             10.0,
             pitch,
-            20.0,
+            20.0f64.to_radians(),
             30.0,
             RadiusProfile::BullNose { corner_mm: 1.5 },
         )
@@ -421,7 +428,7 @@ fn straight_feed_exact_solvers_agree_on_general_cutters() {
 fn circular_feed_of_large_radius_approaches_straight_feed() {
     // a circle of radius r_c bends the feed by f/r_c per tooth: the chip differs from straight
     // feed by O(h·(R/r_c)) — below 0.3 % of f for r_c = 5 m
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.01, deg(40.0)).unwrap();
     let fz = 0.1;
     let speed = fz * 4.0 * 6000.0 / 60.0;
@@ -456,7 +463,7 @@ fn compensation_fit_round_trip_recovers_known_k() {
     // recover them within 4 standard errors, and the standard errors must be consistent with σ
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
-    let cutter = Cutter::flat(6.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(6.0, 4, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.010, deg(40.0)).unwrap();
     let kin = straight_kin(&cutter, &runout, 0.2);
     let truth = EquivalentParams {
@@ -541,7 +548,7 @@ fn joint_path_velocities_match_finite_differences() {
 
 #[test]
 fn joint_path_without_rotation_is_straight_feed() {
-    let cutter = Cutter::flat(8.0, 3, 30.0).unwrap();
+    let cutter = Cutter::flat(8.0, 3, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.01, deg(15.0)).unwrap();
     let flat = straight_kin(&cutter, &runout, 0.1);
     let v = flat.motion().v.x;
@@ -607,27 +614,27 @@ fn newton_stopping_rule_accepts_only_converged_iterates() {
     .unwrap();
     let cases = [
         (
-            Cutter::flat(10.0, 4, 30.0).unwrap(),
+            Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap(),
             0.010,
             Motion::Straight(StraightFeed::along_x(40.0)),
         ),
         (
-            Cutter::flat(10.0, 4, 45.0).unwrap(),
+            Cutter::flat(10.0, 4, 45.0f64.to_radians()).unwrap(),
             0.010,
             swing(Vec3::y()),
         ),
         (
-            Cutter::flat(6.0, 3, 30.0).unwrap(),
+            Cutter::flat(6.0, 3, 30.0f64.to_radians()).unwrap(),
             0.020,
             swing(Vec3::new(1.0, 0.3, 0.0)),
         ),
         (
-            Cutter::flat(10.0, 4, 30.0).unwrap(),
+            Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap(),
             0.010,
             Motion::Path(path),
         ),
         (
-            Cutter::flat(0.5, 2, 30.0).unwrap(),
+            Cutter::flat(0.5, 2, 30.0f64.to_radians()).unwrap(),
             0.002,
             Motion::Straight(StraightFeed::along_x(0.4)),
         ),
@@ -729,7 +736,7 @@ fn spindle_point_near_equals_spindle_point() {
         let cutter = Cutter::new(
             10.0,
             vec![1.4, 1.7, 1.5, TAU - 4.6],
-            35.0,
+            35.0f64.to_radians(),
             30.0,
             profile.clone(),
         )

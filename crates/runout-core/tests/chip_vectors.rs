@@ -14,7 +14,7 @@ fn app_a3(
     omega_swing: f64,
     w: Vec3,
 ) -> ToolKinematics<Motion> {
-    let cutter = Cutter::flat(2.0 * r, k, 30.0).unwrap();
+    let cutter = Cutter::flat(2.0 * r, k, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(rho, 40f64.to_radians()).unwrap();
     let v = Vec3::new(fz * k as f64 * 100.0, 0.0, 0.0); // 6000 rpm: T = 0.01 s
     let motion = if omega_swing == 0.0 {

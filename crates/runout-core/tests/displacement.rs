@@ -704,7 +704,7 @@ fn ill_posed_cases_are_flagged() {
 /// Σ h_i = K·f_z when every tooth cuts (h_i = f_z + R_i − R_{i−1}).
 #[test]
 fn consequences_reference_cutter() {
-    let c = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let c = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let r = Runout::new(0.008, 0.0).unwrap();
     let q = consequences(&c, &r, 0.0, Some(0.08), Some(20.0)).unwrap();
     assert!((q.tooth_radii_mm[0] - 5.008).abs() < 1e-12);
@@ -728,7 +728,7 @@ proptest! {
     #[test]
     fn prop_joint_exact(k in 3usize..=6, d in 0.2f64..12.0, rho_um in 1.0f64..30.0,
                         lam in -179.0f64..180.0, helix in 0.0f64..45.0, z in 0.0f64..3.0) {
-        let c = Cutter::flat(d, k, helix).unwrap();
+        let c = Cutter::flat(d, k, f64::to_radians(helix)).unwrap();
         let t = Runout::new(rho_um * 1e-3, lam.to_radians()).unwrap();
         let mut o = opts(c.clone());
         o.height_mm = z;

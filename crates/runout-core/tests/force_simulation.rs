@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 const REF_COEF: ([f64; 3], [f64; 3]) = ([1889.2, 806.1, 291.0], [63.12, 113.7, -3.1]);
 
 fn reference(runout: Runout, coef: CuttingCoefficients, helix: f64) -> (ForceModel, ArcChip) {
-    let cutter = Cutter::flat(10.0, 4, helix).unwrap();
+    let cutter = Cutter::flat(10.0, 4, f64::to_radians(helix)).unwrap();
     let cut = Cut::new(3240.0, 0.08, 1.0)
         .unwrap()
         .radial(2.0, MillingMode::Down, &cutter)

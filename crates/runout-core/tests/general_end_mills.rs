@@ -12,7 +12,7 @@
 use proptest::prelude::*;
 use runout_core::edge::EdgeTable;
 use runout_core::identify::{
-    calibrate_mean_forces_general, force_from_basis, Axis, MeanForceDesign, MeanForces,
+    calibrate_mean_forces_general, force_from_basis, FrameAxis, MeanForceDesign, MeanForces,
     RevolutionModel,
 };
 use runout_core::*;
@@ -32,7 +32,14 @@ fn profiles() -> Vec<RadiusProfile> {
 }
 
 fn cutter(d: f64, k: usize, helix: f64, p: RadiusProfile) -> Cutter {
-    Cutter::new(d, vec![TAU / k as f64; k], helix, f64::INFINITY, p).unwrap()
+    Cutter::new(
+        d,
+        vec![TAU / k as f64; k],
+        helix.to_radians(),
+        f64::INFINITY,
+        p,
+    )
+    .unwrap()
 }
 
 fn model(
@@ -153,7 +160,7 @@ fn flat_end_through_the_general_kernel_equals_the_cylindrical_model() {
     ];
     let mut worst = 0.0f64;
     for (k, helix, runout, mode, ae, disks) in cases {
-        let c = Cutter::flat(10.0, k, helix).unwrap();
+        let c = Cutter::flat(10.0, k, f64::to_radians(helix)).unwrap();
         let (m, chip) = model(&c, runout, 0.06, 2.0, ae, mode, coef());
         let samp = Sampling::new(1.0, 0.7, disks).unwrap();
         let a = m.simulate(&chip, &samp);
@@ -297,7 +304,11 @@ fn revolution_model_equals_simulation_for_every_profile() {
         let s = m.simulate(&chip, &samp);
         let rev = RevolutionModel::new(&c, &m.cut, 0.0, 360, disks);
         let sums = rev.sums(runout.vector_at(0.0), [0.0; 2], false);
-        for (axis, sim) in [(Axis::X, &s.fx), (Axis::Y, &s.fy), (Axis::Z, &s.fz)] {
+        for (axis, sim) in [
+            (FrameAxis::X, &s.fx),
+            (FrameAxis::Y, &s.fy),
+            (FrameAxis::Z, &s.fz),
+        ] {
             let scale = sim.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             assert!(scale > 1.0, "{p:?}: no force");
             for (q, b) in sums.base.iter().enumerate() {
@@ -468,7 +479,7 @@ fn ball_engagement_per_disk() {
     // a_e/R(z) > a_e/R.
     let top = t.disk(199).width.to_degrees();
     assert!((top - 27.9).abs() < 0.2, "{top}");
-    let flat = cut.immersion(&Cutter::flat(6.0, 3, 30.0).unwrap());
+    let flat = cut.immersion(&Cutter::flat(6.0, 3, 30.0f64.to_radians()).unwrap());
     assert!((flat.1.to_degrees() - 16.6).abs() < 0.1);
 }
 
@@ -585,9 +596,16 @@ fn ball_round_trip_on_a_synchronous_grid() {
             v.iter().map(|x| x + noise.sample(&mut rng)).collect()
         };
         let (fx, fy, fzz) = (noisy(&s.fx), noisy(&s.fy), noisy(&s.fz));
-        let waveform =
-            AveragedWaveform::average(0.0, 360, &[(Axis::X, &fx), (Axis::Y, &fy), (Axis::Z, &fzz)])
-                .unwrap();
+        let waveform = AveragedWaveform::average(
+            0.0,
+            360,
+            &[
+                (FrameAxis::X, &fx),
+                (FrameAxis::Y, &fy),
+                (FrameAxis::Z, &fzz),
+            ],
+        )
+        .unwrap();
         cases.push(WaveformCase {
             cutter: c.clone(),
             cut: m.cut,

@@ -75,7 +75,7 @@ fn four_flute() -> Setup {
 const FEEDS: [f64; 5] = [0.04, 0.06, 0.08, 0.10, 0.12];
 
 fn cutter_cut(s: &Setup, fz: f64) -> (Cutter, Cut) {
-    let cutter = Cutter::flat(s.diameter, s.teeth, s.helix_deg).unwrap();
+    let cutter = Cutter::flat(s.diameter, s.teeth, s.helix_deg.to_radians()).unwrap();
     let cut = Cut::new(s.rpm, fz, s.ap)
         .unwrap()
         .radial(s.ae, s.mode, &cutter)
@@ -111,7 +111,7 @@ fn recording(s: &Setup, fz: f64, chain: &MeasuringChain, seed: u64) -> WaveformC
     let fs_fine = s.sample_rate * OVERSAMPLE as f64;
     let mut rng = StdRng::seed_from_u64(seed);
     let white = Normal::new(0.0, 1.0).unwrap();
-    let mut channel = |v: &[f64], axis: Axis| -> Vec<f64> {
+    let mut channel = |v: &[f64], axis: FrameAxis| -> Vec<f64> {
         let filtered = chain.axis(axis).filter(fs_fine, v);
         let kept: Vec<f64> = filtered
             .iter()
@@ -130,12 +130,13 @@ fn recording(s: &Setup, fz: f64, chain: &MeasuringChain, seed: u64) -> WaveformC
             })
             .collect()
     };
-    let fx = channel(&series.fx, Axis::X);
-    let fy = channel(&series.fy, Axis::Y);
+    let fx = channel(&series.fx, FrameAxis::X);
+    let fy = channel(&series.fy, FrameAxis::Y);
     WaveformCase {
         cutter,
         cut,
-        waveform: AveragedWaveform::average(0.0, n, &[(Axis::X, &fx), (Axis::Y, &fy)]).unwrap(),
+        waveform: AveragedWaveform::average(0.0, n, &[(FrameAxis::X, &fx), (FrameAxis::Y, &fy)])
+            .unwrap(),
     }
 }
 
@@ -195,7 +196,7 @@ fn resonant_set(s: &Setup) -> Vec<WaveformCase> {
 
 fn fitted_modes() -> ChainModel {
     ChainModel::FitModes {
-        axes: vec![(Axis::X, None), (Axis::Y, None)],
+        axes: vec![(FrameAxis::X, None), (FrameAxis::Y, None)],
         fit_gain: false,
     }
 }
@@ -363,7 +364,7 @@ fn per_recording_runout_is_consistent_across_feeds() {
         .collect();
     let joint = full_signal_fit(&cases, &chain_options(&s, fitted_modes(), false)).unwrap();
     let modes = &joint.chain.as_ref().unwrap().modes;
-    let mode_of = |a: Axis| {
+    let mode_of = |a: FrameAxis| {
         modes
             .iter()
             .find(|m| m.axis == a)
@@ -377,8 +378,8 @@ fn per_recording_runout_is_consistent_across_feeds() {
             })
     };
     let chain = MeasuringChain {
-        x: mode_of(Axis::X),
-        y: mode_of(Axis::Y),
+        x: mode_of(FrameAxis::X),
+        y: mode_of(FrameAxis::Y),
         z: AxisChain::Rigid,
     };
     let mut rho = Vec::new();

@@ -97,7 +97,8 @@ fn one(i: usize) -> Outcome {
     let case = WaveformCase {
         cutter,
         cut,
-        waveform: AveragedWaveform::average(0.0, SPR, &[(Axis::X, &fx), (Axis::Y, &fy)]).unwrap(),
+        waveform: AveragedWaveform::average(0.0, SPR, &[(FrameAxis::X, &fx), (FrameAxis::Y, &fy)])
+            .unwrap(),
     };
     let fit = full_signal_fit(&[case], &FullSignalOptions::default()).unwrap();
     Outcome {

@@ -67,7 +67,7 @@ fn errors(c: &MeanForceCalibration) -> [f64; 6] {
 fn recovers_coefficients_without_runout() {
     let feeds = [0.04, 0.06, 0.08, 0.10, 0.12];
     for (helix, disks) in [(0.0, 1), (30.0, 40)] {
-        let c = Cutter::flat(10.0, 4, helix).unwrap();
+        let c = Cutter::flat(10.0, 4, f64::to_radians(helix)).unwrap();
         for mode in [MillingMode::Slot, MillingMode::Up, MillingMode::Down] {
             let cut_at = |f| {
                 Cut::new(3000.0, f, 2.0)
@@ -118,7 +118,7 @@ fn recovers_coefficients_without_runout() {
 #[test]
 fn runout_and_mean_forces() {
     let feeds = [0.06, 0.08, 0.10, 0.12];
-    let c = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let c = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let r = Runout::new(0.005, 0.7).unwrap();
     // (1) every tooth in contact over the whole engagement (20°..160°, f_z sin 20° ≥ 20 µm >
     // |ΔR| ≤ 7 µm): the runout terms cancel exactly in the mean (Σ ΔR_i = 0) → as without runout.

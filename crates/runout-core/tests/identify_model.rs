@@ -22,7 +22,11 @@ fn compare(cutter: Cutter, runout: Runout, cut: Cut, disks: usize) {
     let e = runout.vector_at(0.0);
     let sums = rev.sums(e, runout.tilt(), false);
     let scale = s.fxy().into_iter().fold(0.0, f64::max);
-    for (axis, v) in [(Axis::X, &s.fx), (Axis::Y, &s.fy), (Axis::Z, &s.fz)] {
+    for (axis, v) in [
+        (FrameAxis::X, &s.fx),
+        (FrameAxis::Y, &s.fy),
+        (FrameAxis::Z, &s.fz),
+    ] {
         for (q, b) in sums.base.iter().enumerate() {
             let f = force_from_basis(axis, b, &coeffs());
             // same equations and discretisation: agreement to rounding (1e-9 of the peak force)
@@ -37,7 +41,7 @@ fn compare(cutter: Cutter, runout: Runout, cut: Cut, disks: usize) {
 
 #[test]
 fn revolution_model_matches_simulation() {
-    let c4 = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let c4 = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let r = Runout::new(0.012, 0.7).unwrap();
     let up = Cut::new(3000.0, 0.08, 2.0)
         .unwrap()
@@ -78,7 +82,7 @@ fn revolution_model_matches_simulation() {
 
 #[test]
 fn runout_derivatives_match_finite_differences() {
-    let c = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let c = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let cut = Cut::new(3000.0, 0.08, 2.0)
         .unwrap()
         .radial(4.0, MillingMode::Down, &c)
@@ -108,7 +112,7 @@ fn runout_derivatives_match_finite_differences() {
         let mut worst: f64 = 0.0;
         let mut scale: f64 = 0.0;
         for q in 0..360 {
-            for axis in [Axis::X, Axis::Y, Axis::Z] {
+            for axis in [FrameAxis::X, FrameAxis::Y, FrameAxis::Z] {
                 let fd = (force_from_basis(axis, &sp.base[q], &kc)
                     - force_from_basis(axis, &sm.base[q], &kc))
                     / (2.0 * h);
@@ -165,7 +169,7 @@ fn frequency_estimate_exact_on_linear_chip_model() {
         (2, 30.0, 0.008, 40.0),
         (3, 30.0, 0.005, -150.0),
     ] {
-        let c = Cutter::flat(10.0, k, helix).unwrap();
+        let c = Cutter::flat(10.0, k, f64::to_radians(helix)).unwrap();
         let r = Runout::new(rho, f64::to_radians(lam)).unwrap();
         let cut = Cut::new(3240.0, 0.1, 1.0)
             .unwrap()
@@ -185,8 +189,12 @@ fn frequency_estimate_exact_on_linear_chip_model() {
         };
         let disks = if helix > 0.0 { 16 } else { 1 };
         let s = model.simulate(&chip, &Sampling::new(1.0, 0.5, disks).unwrap());
-        let w =
-            AveragedWaveform::average(0.0, s.len(), &[(Axis::X, &s.fx), (Axis::Y, &s.fy)]).unwrap();
+        let w = AveragedWaveform::average(
+            0.0,
+            s.len(),
+            &[(FrameAxis::X, &s.fx), (FrameAxis::Y, &s.fy)],
+        )
+        .unwrap();
         let est = frequency_estimate(
             &[WaveformCase {
                 cutter: c,
@@ -214,9 +222,9 @@ fn frequency_estimate_exact_on_linear_chip_model() {
     let fx: Vec<f64> = s
         .base
         .iter()
-        .map(|b| force_from_basis(Axis::X, b, &coeffs()))
+        .map(|b| force_from_basis(FrameAxis::X, b, &coeffs()))
         .collect();
-    let w = AveragedWaveform::average(0.0, n, &[(Axis::X, &fx)]).unwrap();
+    let w = AveragedWaveform::average(0.0, n, &[(FrameAxis::X, &fx)]).unwrap();
     let e = frequency_estimate(
         &[WaveformCase {
             cutter: c,

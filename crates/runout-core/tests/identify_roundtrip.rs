@@ -61,7 +61,7 @@ fn recording(
     kc: CuttingCoefficients,
     seed: u64,
 ) -> (WaveformCase, ForceSeries) {
-    let cutter = Cutter::flat(10.0, s.teeth, s.helix_deg).unwrap();
+    let cutter = Cutter::flat(10.0, s.teeth, s.helix_deg.to_radians()).unwrap();
     let (model, chip) = force_model(s, cutter.clone(), fz, kc);
     let cut = model.cut;
     // the "truth" uses finer disks (helix lag 0.05° per disk) than the identification model's
@@ -76,9 +76,16 @@ fn recording(
         v.iter().map(|x| x + noise.sample(&mut rng)).collect()
     };
     let (fx, fy, fz_) = (noisy(&series.fx), noisy(&series.fy), noisy(&series.fz));
-    let waveform =
-        AveragedWaveform::average(0.0, 360, &[(Axis::X, &fx), (Axis::Y, &fy), (Axis::Z, &fz_)])
-            .unwrap();
+    let waveform = AveragedWaveform::average(
+        0.0,
+        360,
+        &[
+            (FrameAxis::X, &fx),
+            (FrameAxis::Y, &fy),
+            (FrameAxis::Z, &fz_),
+        ],
+    )
+    .unwrap();
     assert_eq!(waveform.revolutions, 20);
     (
         WaveformCase {
@@ -457,7 +464,7 @@ fn two_teeth_straight_flutes_offset_across_the_tooth_line_is_below_the_noise_bou
 fn tilt_round_trip() {
     // offset 6 µm at 40° plus tilt 2 µm/mm at −60° over a_p 4 mm (helix 30°, K 4, down a_e 3):
     // fitted with the tilt vector; both recovered (offset within 0.3 µm, tilt within 0.2 µm/mm).
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.006, 40f64.to_radians())
         .unwrap()
         .with_tilt(0.002, -60f64.to_radians())
@@ -481,9 +488,12 @@ fn tilt_round_trip() {
         v.iter().map(|x| x + n.sample(&mut rng)).collect()
     };
     let (x, y, z) = (noisy(&s.fx), noisy(&s.fy), noisy(&s.fz));
-    let waveform =
-        AveragedWaveform::average(0.0, 360, &[(Axis::X, &x), (Axis::Y, &y), (Axis::Z, &z)])
-            .unwrap();
+    let waveform = AveragedWaveform::average(
+        0.0,
+        360,
+        &[(FrameAxis::X, &x), (FrameAxis::Y, &y), (FrameAxis::Z, &z)],
+    )
+    .unwrap();
     let fit = full_signal_fit(
         &[WaveformCase {
             cutter,

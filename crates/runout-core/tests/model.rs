@@ -91,7 +91,12 @@ fn invalid_parameters_name_the_parameter() {
         Cutter::flat(f64::NAN, 2, 0.0).unwrap_err().param,
         "diameter_mm"
     );
-    assert_eq!(Cutter::flat(10.0, 2, 95.0).unwrap_err().param, "helix_deg");
+    assert_eq!(
+        Cutter::flat(10.0, 2, 95.0f64.to_radians())
+            .unwrap_err()
+            .param,
+        "helix_deg"
+    );
     let bad_pitch = Cutter::new(10.0, vec![1.0, 1.0], 0.0, 10.0, RadiusProfile::Flat).unwrap_err();
     assert_eq!(bad_pitch.param, "pitch_deg");
     assert_eq!(Cut::new(1000.0, 0.0, 1.0).unwrap_err().param, "fz_mm");
@@ -126,7 +131,7 @@ proptest! {
     /// Exact radius equals the law of cosines of eq. (0.1) for any tooth, height and helix.
     #[test]
     fn exact_radius_law_of_cosines(k in 1usize..8, rho_um in 0.0f64..50.0, lam in -3.2f64..3.2, z in 0.0f64..20.0, helix in 0.0f64..45.0) {
-        let c = Cutter::flat(8.0, k, helix).unwrap();
+        let c = Cutter::flat(8.0, k, f64::to_radians(helix)).unwrap();
         let r = Runout::new(rho_um * 1e-3, lam).unwrap();
         for i in 0..k {
             let psi = c.tooth_angle(i, z);

@@ -6,7 +6,7 @@ use runout_core::*;
 
 /// Simulated |F| signal of a 4-flute cut (example case), with 2 % white noise, as channel Fx.
 fn force_signal() -> Vec<f64> {
-    let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.008, -0.87).unwrap();
     let cut = Cut::new(3240.0, 0.08, 2.0)
         .unwrap()

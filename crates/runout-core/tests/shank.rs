@@ -185,7 +185,7 @@ const RPM: f64 = 3000.0;
 /// two sensor heights, runout offset + tilt and shank form error rotating with the spindle, gap
 /// offsets, a slow drift, 0.1 % spindle-speed error, Gaussian sensor noise; optional pulse.
 fn synthetic(air_before: f64, cut_revs: f64, air_after: f64, pulse: bool, seed: u64) -> Synthetic {
-    let cutter = Cutter::flat(8.0, 3, 30.0).unwrap();
+    let cutter = Cutter::flat(8.0, 3, 30.0f64.to_radians()).unwrap();
     let tool_runout = Runout::new(0.010, 30f64.to_radians()).unwrap();
     let cut = Cut::new(RPM, 0.05, 2.0)
         .unwrap()
@@ -674,7 +674,7 @@ fn harmonic_error(f: &[f64], spindle_hz: f64, e: impl Fn(f64) -> f64) -> f64 {
 /// mode it matches the true force as closely as a rigid recording does.
 #[test]
 fn bending_mode_round_trip_wrong_without_correction_right_with_it() {
-    let cutter = Cutter::flat(8.0, 3, 30.0).unwrap();
+    let cutter = Cutter::flat(8.0, 3, 30.0f64.to_radians()).unwrap();
     let tool_runout = Runout::new(0.010, 30f64.to_radians()).unwrap();
     let cut = Cut::new(RPM, 0.05, 2.0)
         .unwrap()
@@ -815,7 +815,7 @@ fn bending_mode_round_trip_wrong_without_correction_right_with_it() {
 /// shows none; the checks warn without a correction and with a correction at the wrong frequency.
 #[test]
 fn resonance_seen_in_the_cut_spectrum() {
-    let cutter = Cutter::flat(8.0, 3, 30.0).unwrap();
+    let cutter = Cutter::flat(8.0, 3, 30.0f64.to_radians()).unwrap();
     let tool_runout = Runout::new(0.010, 0.5).unwrap();
     let cut = Cut::new(RPM, 0.05, 2.0)
         .unwrap()

@@ -40,10 +40,10 @@ struct Synthetic {
 }
 
 impl Synthetic {
-    fn chunk(&self) -> Chunk<'_> {
-        Chunk::xyz(&self.fx, &self.fy, &self.fz)
+    fn chunk(&self) -> SignalChunk<'_> {
+        SignalChunk::xyz(&self.fx, &self.fy, &self.fz)
     }
-    fn chunk_with_pulse(&self) -> Chunk<'_> {
+    fn chunk_with_pulse(&self) -> SignalChunk<'_> {
         self.chunk().with_pulse(&self.pulse)
     }
     /// Noiseless steady force at spindle angle θ (linear interpolation of the fine grid).
@@ -60,7 +60,7 @@ impl Synthetic {
 /// 3 teeth, D10, helix 30°, ρ = 10 µm at λ = 40°, down milling a_e 3 mm, a_p 2 mm, f_z 0.06 mm;
 /// true speed `true_rpm` (nominal 6000), 2 % white noise (of the peak |F_xy|) on every channel.
 fn synthetic(true_rpm: f64, seed: u64) -> Synthetic {
-    let cutter = Cutter::flat(10.0, 3, 30.0).unwrap();
+    let cutter = Cutter::flat(10.0, 3, 30.0f64.to_radians()).unwrap();
     let runout = Runout::new(0.010, 40f64.to_radians()).unwrap();
     let cut = Cut::new(true_rpm, 0.06, 2.0)
         .unwrap()
@@ -163,7 +163,7 @@ fn check_average(syn: &Synthetic, avg: &SyncAverage, theta_shift: f64, dtheta: f
     let n = avg.revolutions as f64;
     let h = TAU * syn.true_hz / FS;
     let mut worst: f64 = 0.0;
-    for (c, comp) in [Component::Fx, Component::Fy, Component::Fz]
+    for (c, comp) in [ForceComponent::Fx, ForceComponent::Fy, ForceComponent::Fz]
         .into_iter()
         .enumerate()
     {
@@ -188,7 +188,7 @@ fn check_average(syn: &Synthetic, avg: &SyncAverage, theta_shift: f64, dtheta: f
     }
     // revolution-to-revolution sd of F_x: white noise σ seen through linear interpolation between
     // two samples has sd σ·√((1−w)² + w²) ∈ [0.71σ, σ]; the median over bins ≈ 0.82σ.
-    let sd = &avg.component(Component::Fx).sd;
+    let sd = &avg.component(ForceComponent::Fx).sd;
     let mut sorted = sd.clone();
     sorted.sort_by(f64::total_cmp);
     let med = sorted[sorted.len() / 2];
@@ -213,7 +213,7 @@ fn check_average(syn: &Synthetic, avg: &SyncAverage, theta_shift: f64, dtheta: f
 fn check_peaks(syn: &Synthetic, avg: &SyncAverage, theta_shift: f64, shift: usize) {
     let k = syn.truth_peaks.len();
     assert_eq!(avg.tooth_peaks.len(), k);
-    assert_eq!(avg.peak_component, Component::Fxy);
+    assert_eq!(avg.peak_component, ForceComponent::Fxy);
     let h = TAU * syn.true_hz / FS;
     let wxy = |th: f64| {
         let f = syn.truth(th);
@@ -609,7 +609,7 @@ fn phm_config() -> SignalConfig {
 fn phm2010_slice_speed_and_three_tooth_peaks() {
     let (fx, fy, fz) = phm();
     assert_eq!(fx.len(), 1073);
-    let a = analyse(&phm_config(), Chunk::xyz(&fx, &fy, &fz)).unwrap();
+    let a = analyse(&phm_config(), SignalChunk::xyz(&fx, &fy, &fz)).unwrap();
     // Speed: the stated 10,400 rpm within the 2 % warning limit (a real spindle holds its speed
     // to well under 1 %); only ≈ 3 revolutions, so the se is a few rpm.
     println!("{:?}\n{:?}", a.speed, a.average.tooth_peaks);
@@ -630,7 +630,7 @@ fn phm2010_slice_speed_and_three_tooth_peaks() {
     // agree within 3 %.
     let p = &a.average.tooth_peaks;
     assert_eq!(p.len(), 3);
-    assert_eq!(a.average.peak_component, Component::Fxy);
+    assert_eq!(a.average.peak_component, ForceComponent::Fxy);
     let mut v: Vec<f64> = p.iter().map(|t| t.peak).collect();
     v.sort_by(f64::total_cmp);
     let ratio = v[2] / (0.5 * (v[0] + v[1]));
@@ -666,7 +666,7 @@ fn phm2010_slice_speed_and_three_tooth_peaks() {
         a.average.bins
     );
     // streaming gives the same result
-    let streamed = analyse_chunked(&phm_config(), Chunk::xyz(&fx, &fy, &fz), 100).unwrap();
+    let streamed = analyse_chunked(&phm_config(), SignalChunk::xyz(&fx, &fy, &fz), 100).unwrap();
     assert_eq!(format!("{streamed:?}"), format!("{a:?}"));
 }
 
@@ -680,7 +680,7 @@ fn shorter_than_two_revolutions_is_an_error() {
     // 400 samples at 50 kHz = 8 ms = 1.39 revolutions at 10,400 rpm
     let e = analyse(
         &phm_config(),
-        Chunk::xyz(&fx[..400], &fy[..400], &fz[..400]),
+        SignalChunk::xyz(&fx[..400], &fy[..400], &fz[..400]),
     )
     .unwrap_err();
     assert!(
@@ -694,13 +694,13 @@ fn shorter_than_two_revolutions_is_an_error() {
         "{e}"
     );
     assert!(e.to_string().contains("1.39 revolutions"), "{e}");
-    assert!(analyse(&phm_config(), Chunk::xyz(&[], &[], &[])).is_err());
+    assert!(analyse(&phm_config(), SignalChunk::xyz(&[], &[], &[])).is_err());
 }
 
 #[test]
 fn spectrum_inconsistent_with_teeth_or_rpm_is_an_error() {
     let (fx, fy, fz) = phm();
-    let rec = Chunk::xyz(&fx, &fy, &fz);
+    let rec = SignalChunk::xyz(&fx, &fy, &fz);
     for (teeth, rpm) in [(4, 10_400.0), (2, 10_400.0), (3, 7_000.0), (3, 13_000.0)] {
         let cfg = SignalConfig::new(50_000.0, teeth, rpm).unwrap();
         let e = analyse(&cfg, rec).unwrap_err();
@@ -739,7 +739,7 @@ fn spectrum_inconsistent_with_teeth_or_rpm_is_an_error() {
 fn non_finite_samples_and_ragged_channels_are_errors() {
     let (mut fx, fy, fz) = phm();
     fx[500] = f64::NAN;
-    let e = analyse(&phm_config(), Chunk::xyz(&fx, &fy, &fz)).unwrap_err();
+    let e = analyse(&phm_config(), SignalChunk::xyz(&fx, &fy, &fz)).unwrap_err();
     assert!(
         e.to_string()
             .contains("channel `fx`, sample 500 (t = 0.010000 s)"),
@@ -752,20 +752,20 @@ fn non_finite_samples_and_ragged_channels_are_errors() {
         other => panic!("{other}"),
     }
     // chunked: the index is counted from the start of the recording
-    let e = analyse_chunked(&phm_config(), Chunk::xyz(&fx, &fy, &fz), 64).unwrap_err();
+    let e = analyse_chunked(&phm_config(), SignalChunk::xyz(&fx, &fy, &fz), 64).unwrap_err();
     assert!(e.to_string().contains("sample 500"), "{e}");
     let (fx, fy, fz) = phm();
-    let e = analyse(&phm_config(), Chunk::xyz(&fx, &fy[..1000], &fz)).unwrap_err();
+    let e = analyse(&phm_config(), SignalChunk::xyz(&fx, &fy[..1000], &fz)).unwrap_err();
     assert!(
         matches!(e, SignalError::Channels { .. }) && e.to_string().contains("lengths differ"),
         "{e}"
     );
     // a channel that disappears between chunks
     let mut scan = SpindleScan::new(&phm_config()).unwrap();
-    scan.push(Chunk::xyz(&fx[..10], &fy[..10], &fz[..10]))
+    scan.push(SignalChunk::xyz(&fx[..10], &fy[..10], &fz[..10]))
         .unwrap();
     let e = scan
-        .push(Chunk {
+        .push(SignalChunk {
             fx: &fx[10..20],
             fy: &fy[10..20],
             fz: None,
@@ -782,10 +782,10 @@ fn noise_air_cut_and_broken_pulse_are_errors() {
     let noise: Vec<f64> = (0..n).map(|_| rng.random::<f64>() - 0.5).collect();
     let zero = vec![0.0; n];
     // white noise: no tooth-passing line
-    let e = analyse(&phm_config(), Chunk::xyz(&noise, &noise, &zero)).unwrap_err();
+    let e = analyse(&phm_config(), SignalChunk::xyz(&noise, &noise, &zero)).unwrap_err();
     assert!(matches!(e, SignalError::SpectrumInconsistent { .. }), "{e}");
     // constant force: flat spectrum
-    let e = analyse(&phm_config(), Chunk::xyz(&zero, &zero, &zero)).unwrap_err();
+    let e = analyse(&phm_config(), SignalChunk::xyz(&zero, &zero, &zero)).unwrap_err();
     assert!(e.to_string().contains("no variation"), "{e}");
     // a pulse channel that never pulses
     let syn = synthetic(6060.0, 6);
@@ -837,7 +837,7 @@ proptest! {
                 .collect()
         };
         let (fx, fy, fz) = (mk(&mut rng), mk(&mut rng), mk(&mut rng));
-        match analyse_chunked(&cfg, Chunk::xyz(&fx, &fy, &fz), chunk) {
+        match analyse_chunked(&cfg, SignalChunk::xyz(&fx, &fy, &fz), chunk) {
             Ok(a) => {
                 prop_assert!(a.speed.rpm.is_finite() && a.speed.rpm > 0.0);
                 prop_assert!(a.average.tooth_peaks.iter().all(|p| p.peak.is_finite()));

@@ -1,7 +1,7 @@
 //! Plots of the displacement methods (methods.md §1): polar plot of the per-tooth radii with the
 //! runout vector, and runout vs height with the regression line.
 
-use crate::plot::{colour, e2s, PlotError};
+use crate::plot::{colour, draw_legend, e2s, legend_dot, legend_line, PlotError};
 use crate::render_plot;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -78,7 +78,7 @@ fn draw_teeth<DB: DrawingBackend>(
         ))
         .map_err(e2s)?
         .label("nominal radius")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.mix(0.4)));
+        .legend(legend_line(BLACK.mix(0.4)));
     if let Some(l) = d.angle_rad {
         let rho = d.offset_um;
         chart
@@ -128,7 +128,7 @@ fn draw_teeth<DB: DrawingBackend>(
         )
         .map_err(e2s)?
         .label("measured (tooth tip)")
-        .legend(|(x, y)| Circle::new((x + 9, y), 5, colour(1).filled()));
+        .legend(legend_dot(colour(1)));
     if let Some(m) = &d.model_um {
         chart
             .draw_series(
@@ -141,13 +141,7 @@ fn draw_teeth<DB: DrawingBackend>(
             .label("model (exact)")
             .legend(|(x, y)| Cross::new((x + 9, y), 5, colour(2).stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::LowerRight)
-        .draw()
-        .map_err(e2s)?;
+    draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
     Ok(())
 }
 
@@ -219,7 +213,7 @@ fn draw_heights<DB: DrawingBackend>(
         ))
         .map_err(e2s)?
         .label(d.line_label.clone())
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour(0).stroke_width(2)));
+        .legend(legend_line(colour(0).stroke_width(2)));
     chart
         .draw_series(
             d.points
@@ -228,7 +222,7 @@ fn draw_heights<DB: DrawingBackend>(
         )
         .map_err(e2s)?
         .label("measured")
-        .legend(|(x, y)| Circle::new((x + 9, y), 5, colour(1).filled()));
+        .legend(legend_dot(colour(1)));
     let (z, r, _) = d.at;
     chart
         .draw_series(LineSeries::new(
@@ -245,12 +239,6 @@ fn draw_heights<DB: DrawingBackend>(
         .map_err(e2s)?
         .label(format!("z = {z} mm: {r:.3} µm ± 2σ"))
         .legend(|(x, y)| TriangleMarker::new((x + 9, y), 6, colour(3).filled()));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()
-        .map_err(e2s)?;
+    draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     Ok(())
 }

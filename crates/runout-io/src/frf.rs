@@ -19,25 +19,15 @@
 use runout_core::chain::{AxisChain, Complex64, FrfCurve, MeasuringChain};
 use std::path::Path;
 
-/// Error naming the file, the line and what was expected.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}{}: {message}", if *line > 0 { format!(":{line}") } else { String::new() })]
-pub struct FrfError {
-    /// The file.
-    pub file: String,
-    /// 1-based line (0 = whole file).
-    pub line: usize,
-    /// What is wrong.
-    pub message: String,
-}
+/// Error naming the file, the line and what was expected (the shared [`crate::LocatedError`]).
+pub type FrfError = crate::LocatedError;
 
 /// Read an FRF table from a file (see the module docs).
 pub fn read_frf(path: &Path) -> Result<MeasuringChain, FrfError> {
     let file = path.display().to_string();
     let text = crate::textfile::read_text(path).map_err(|e| FrfError {
-        file: file.clone(),
-        line: e.line.unwrap_or(0),
         message: format!("FRF table: {}", e.message),
+        ..e
     })?;
     parse_frf(&file, &text)
 }
@@ -50,11 +40,7 @@ fn split(line: &str) -> Vec<&str> {
 
 /// Parse the text of an FRF table; `file` names it in errors.
 pub fn parse_frf(file: &str, text: &str) -> Result<MeasuringChain, FrfError> {
-    let err = |line: usize, message: String| FrfError {
-        file: file.into(),
-        line,
-        message,
-    };
+    let err = |line: usize, message: String| FrfError::new(file, line, message);
     let mut lines = text
         .lines()
         .enumerate()

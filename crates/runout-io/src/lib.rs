@@ -14,6 +14,7 @@ pub mod frf;
 pub mod gcode;
 pub mod grind;
 pub mod lineplot;
+mod located;
 pub mod peak_table;
 pub mod plot;
 pub mod recording;
@@ -21,3 +22,5 @@ pub mod report;
 pub mod textfile;
 pub mod toolpath;
 pub mod units;
+
+pub use located::LocatedError;

@@ -1,7 +1,7 @@
 //! Generic stacked line plots (one or more panels sharing the x axis), used for time histories
 //! such as the shank method's raw signals, deflections and forces.
 
-use crate::plot::{colour, e2s, PlotError};
+use crate::plot::{colour, draw_legend, e2s, PlotError};
 use crate::render_plot;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -103,13 +103,7 @@ fn draw<DB: DrawingBackend>(
                 }
             }
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(e2s)?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     }
     Ok(())
 }

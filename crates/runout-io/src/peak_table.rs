@@ -14,19 +14,9 @@
 use serde::Deserialize;
 use std::path::Path;
 
-/// Error naming the file, line (and column) and what was expected.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}{}{}: {message}", if *line > 0 { format!(":{line}") } else { String::new() }, column.map(|c| format!(":{c}")).unwrap_or_default())]
-pub struct PeakTableError {
-    /// The file.
-    pub file: String,
-    /// 1-based line (0 = whole file).
-    pub line: usize,
-    /// 1-based column (field), if known.
-    pub column: Option<usize>,
-    /// What is wrong.
-    pub message: String,
-}
+/// Error naming the file, line (and column) and what was expected (the shared
+/// [`crate::LocatedError`]).
+pub type PeakTableError = crate::LocatedError;
 
 /// Settings shared by all tests of a table (each may be overridden per test or by flags).
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
@@ -101,12 +91,7 @@ struct TomlTable {
 /// Read a peak table; the format follows the extension (`.toml`, else CSV/TSV).
 pub fn read_peak_table(path: &Path) -> Result<PeakTable, PeakTableError> {
     let file = path.display().to_string();
-    let text = crate::textfile::read_text(path).map_err(|e| PeakTableError {
-        file: file.clone(),
-        line: e.line.unwrap_or(0),
-        column: None,
-        message: e.message,
-    })?;
+    let text = crate::textfile::read_text(path)?;
     let is_toml = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"));

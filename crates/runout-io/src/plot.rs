@@ -167,6 +167,51 @@ pub fn partial_path(path: &std::path::Path) -> std::path::PathBuf {
     path.with_file_name(format!(".{stem}.partial-{}.{ext}", std::process::id()))
 }
 
+/// Draw the series legend of `chart` at `position` in the one legend style of every plot:
+/// translucent white box, black border.
+pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(position)
+        .draw()
+        .map_err(e2s)
+}
+
+/// Legend glyph of a line series: an 18 px stroke in `style`.
+pub fn legend_line<S: Into<ShapeStyle>>(
+    style: S,
+) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    let style: ShapeStyle = style.into();
+    move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style)
+}
+
+/// Legend glyph of a marker series: a filled dot of radius 5 px in `colour`.
+pub fn legend_dot(colour: RGBColor) -> impl Fn((i32, i32)) -> Circle<(i32, i32), i32> {
+    move |(x, y)| Circle::new((x + 9, y), 5, colour.filled())
+}
+
+/// Ring spacing of a polar plot of radius `rmax`: the smallest round number (1, 2, 2.5, 5 or 10
+/// × 10ⁿ) at least rmax/4, which gives 3–6 rings.
+///
+/// ```
+/// assert_eq!(runout_io::plot::polar_ring_step(10.0), 2.5);
+/// assert_eq!(runout_io::plot::polar_ring_step(33.0), 10.0);
+/// ```
+pub fn polar_ring_step(rmax: f64) -> f64 {
+    let raw = rmax / 4.0;
+    let mag = 10f64.powf(raw.log10().floor());
+    [1.0, 2.0, 2.5, 5.0, 10.0]
+        .iter()
+        .map(|f| f * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag)
+}
+
 /// Stringify a plotters error.
 pub fn e2s<E: std::fmt::Debug>(e: E) -> String {
     format!("{e:?}")
@@ -241,7 +286,7 @@ fn draw_forces<DB: DrawingBackend>(
             ))
             .map_err(e2s)?
             .label(name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
+            .legend(legend_line(c.stroke_width(2)));
     }
     // mark each tooth's peak in every revolution
     let turns = (x1 / 360.0).ceil() as usize;
@@ -255,14 +300,8 @@ fn draw_forces<DB: DrawingBackend>(
             .draw_series(pts.into_iter().map(|pt| Circle::new(pt, 5, c.filled())))
             .map_err(e2s)?
             .label(format!("tooth {} peak {:.1} N", p.tooth, p.peak_fxy))
-            .legend(move |(x, y)| Circle::new((x + 9, y), 5, c.filled()));
+            .legend(legend_dot(c));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(e2s)?;
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }

@@ -6,17 +6,9 @@ use runout_core::limits::{MAX_LINE_BYTES, MAX_TABLE_BYTES};
 use std::io::Read;
 use std::path::Path;
 
-/// Why a text file could not be read; `Display` gives `file[:line]: message`.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
-pub struct TextFileError {
-    /// The file.
-    pub file: String,
-    /// 1-based line, where the problem is on one line.
-    pub line: Option<usize>,
-    /// What is wrong and what the limit is.
-    pub message: String,
-}
+/// Why a text file could not be read; `Display` gives `file[:line]: message` (the shared
+/// [`crate::LocatedError`]; line 0 = the whole file).
+pub type TextFileError = crate::LocatedError;
 
 /// At most 80 characters of `text` (with `…` when cut), for messages; control characters
 /// (line breaks, tabs, NUL …) are escaped (`\n`) so that a message stays on one line.
@@ -46,10 +38,8 @@ pub fn quote(text: &str) -> String {
 /// over [`MAX_LINE_BYTES`].
 pub fn read_text(path: &Path) -> Result<String, TextFileError> {
     let file = path.display().to_string();
-    let err = |line: Option<usize>, message: String| TextFileError {
-        file: file.clone(),
-        line,
-        message,
+    let err = |line: Option<usize>, message: String| {
+        TextFileError::new(file.clone(), line.unwrap_or(0), message)
     };
     let too_big = |size: u64| {
         err(
@@ -93,11 +83,8 @@ pub fn read_text(path: &Path) -> Result<String, TextFileError> {
 /// The same checks as [`read_text`] on bytes already in memory (a config or table passed by a
 /// library caller); `file` names them in messages.
 pub fn text_from_bytes(file: &str, bytes: Vec<u8>) -> Result<String, TextFileError> {
-    let err = |line: Option<usize>, message: String| TextFileError {
-        file: file.to_string(),
-        line,
-        message,
-    };
+    let err =
+        |line: Option<usize>, message: String| TextFileError::new(file, line.unwrap_or(0), message);
     if bytes.len() as u64 > MAX_TABLE_BYTES {
         return Err(err(
             None,
@@ -127,7 +114,8 @@ fn check_lines(file: &str, bytes: &[u8]) -> Result<(), TextFileError> {
             let head = String::from_utf8_lossy(&line[..line.len().min(320)]);
             return Err(TextFileError {
                 file: file.into(),
-                line: Some(n + 1),
+                line: n + 1,
+                column: None,
                 message: format!(
                     "line of {} bytes: longer than {MAX_LINE_BYTES} (limit MAX_LINE_BYTES), starting `{}`",
                     line.len(),
@@ -156,7 +144,7 @@ mod tests {
         let p = dir.path().join("one_line.csv");
         std::fs::write(&p, "a".repeat(MAX_LINE_BYTES + 10)).unwrap();
         let e = read_text(&p).unwrap_err();
-        assert_eq!(e.line, Some(1));
+        assert_eq!(e.line(), Some(1));
         assert!(e.message.contains("MAX_LINE_BYTES"), "{e}");
         assert!(e.to_string().len() < 300, "{e}");
         let big = dir.path().join("big.csv");

@@ -71,7 +71,7 @@ pub enum ToolpathError {
 /// Read a toolpath; CSV when the extension is `.csv`, APT CL otherwise.
 pub fn read_toolpath(path: &Path) -> Result<Toolpath, ToolpathError> {
     let name = path.display().to_string();
-    let text = crate::textfile::read_text(path).map_err(|e| match e.line {
+    let text = crate::textfile::read_text(path).map_err(|e| match e.line() {
         Some(line) => ToolpathError::Parse {
             file: name.clone(),
             line,

@@ -37,7 +37,7 @@ pub fn run() -> anyhow::Result<ForceReport> {
 
 /// The request: recording and config as bytes in memory.
 pub fn request() -> anyhow::Result<ForceRequest> {
-    let cutter = Cutter::flat(8.0, 3, 30.0)?;
+    let cutter = Cutter::flat(8.0, 3, 30.0f64.to_radians())?;
     let runout = Runout::new(0.010, 0.5)?;
     let cut = Cut::new(3000.0, 0.05, 2.0)?.radial(2.0, MillingMode::Down, &cutter)?;
     let chip = ArcChip::new(&cutter, &runout, 0.05)?;

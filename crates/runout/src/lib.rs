@@ -21,13 +21,16 @@
 //! ```
 
 pub mod batch;
+pub mod case;
 pub mod chip;
 pub mod displacement;
 pub mod grind;
 pub mod identify;
+pub mod inspect;
 pub mod job;
 pub mod schema;
 pub mod shank;
+pub mod simulate;
 pub mod spill;
 
 pub use job::{to_json, NoProgress, Progress, Report, Source};

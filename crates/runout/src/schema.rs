@@ -34,5 +34,7 @@ pub fn all() -> Vec<(&'static str, String, String)> {
         one::<crate::identify::PeaksReport>(),
         one::<crate::identify::TestsReport>(),
         one::<crate::identify::RecordingsReport>(),
+        one::<crate::simulate::SimulateReport>(),
+        one::<crate::inspect::InspectReport>(),
     ]
 }

@@ -9,6 +9,7 @@
 //! * `runout shank calibrate RECORDING --config shank.toml --force-channel F --load-point-mm A`
 //!   — static calibration of K_δ (and the holder term with several load points).
 
+use crate::flags::{choice, PlotFormat};
 use crate::output;
 use anyhow::{bail, Context, Result};
 use runout::shank::{self, render, CalibrateRequest, ForceRequest, LoadPointFrom, SeriesFormat};
@@ -67,6 +68,13 @@ pub struct StiffnessArgs {
     json: Option<PathBuf>,
 }
 
+/// `--binary-type`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum BinaryType {
+    F32,
+    F64,
+}
+
 /// Flags of `runout shank force`.
 #[derive(clap::Args, Debug)]
 pub struct ForceArgs {
@@ -86,7 +94,7 @@ pub struct ForceArgs {
     /// the channels (in the temp directory, ≈ 8 bytes per channel and sample, deleted at the end).
     #[arg(long)]
     reparse: bool,
-    /// Element type of a `.bin` output: f32 or f64.
+    /// Element type of a `.bin` output: f32 | f64 (bytes per value 4 | 8).
     #[arg(long, default_value = "f32")]
     binary_type: String,
     /// Write the JSON summary here (`-` = stdout).
@@ -201,16 +209,15 @@ fn force(a: ForceArgs) -> Result<()> {
     for out in [&a.out, &a.json].into_iter().flatten() {
         output::check_not_input(out, &[&a.recording, &a.config])?;
     }
-    if a.plot_dir.is_some() && a.plot_format != "svg" && a.plot_format != "png" {
-        bail!("--plot-format `{}`: expected svg or png", a.plot_format);
+    if a.plot_dir.is_some() {
+        choice::<PlotFormat>("--plot-format", &a.plot_format)?;
     }
     let mut writer = None;
     if let Some(p) = &a.out {
         let format = if p.extension().is_some_and(|e| e == "bin") {
-            SeriesFormat::Binary(match a.binary_type.as_str() {
-                "f32" => BinaryLayout::F32,
-                "f64" => BinaryLayout::F64,
-                o => bail!("--binary-type `{o}`: expected f32 or f64"),
+            SeriesFormat::Binary(match choice("--binary-type", &a.binary_type)? {
+                BinaryType::F32 => BinaryLayout::F32,
+                BinaryType::F64 => BinaryLayout::F64,
             })
         } else {
             SeriesFormat::Csv

@@ -1,21 +1,12 @@
-//! The simulated measuring chain of `runout simulate --recording …` (issue 11 item 2): a
-//! resonant dynamometer between the cut and the written recording.
-//!
-//! As a real sensor: the cut is simulated [`OVERSAMPLE`]× finer than the recording, each force
-//! channel (with its air-cut padding, so the sensor rings at the cut's entry as a real one does)
-//! runs through the chain at that rate ([`AxisChain::filter`]: exact first-order-hold
-//! integration of each mode, or FFT filtering by a measured FRF), is decimated to the recording
-//! rate, and only then does the measurement noise go in (noise is after the sensor).
+//! Sensor flags of `runout simulate --recording …` (issue 11 item 2): parsed into a
+//! [`SensorRequest`]; the chain itself (modes, FRF filtering, oversampling) is
+//! [`runout::simulate::sensor`].
 
-use anyhow::{bail, Context, Result};
-use runout_core::chain::{AxisChain, MeasuringChain, SensorMode};
+use anyhow::{bail, Result};
+use runout::simulate::SensorRequest;
+use runout::Source;
 use runout_io::units::{parse_quantity, Quantity};
 use std::path::PathBuf;
-
-/// Oversampling of the simulated cut relative to the recording when a sensor chain is given:
-/// the first-order hold of the filter attenuates harmonic f by sinc²(πf/(8·f_s)) — < 0.3 % up
-/// to 0.2·f_s, < 1.3 % at the recording's Nyquist frequency.
-pub const OVERSAMPLE: usize = 8;
 
 /// Sensor flags of `runout simulate --recording …`.
 #[derive(clap::Args, Debug, Default)]
@@ -36,17 +27,6 @@ pub struct SensorFlags {
     /// row; axes without columns are rigid), instead of --sensor-mode-hz. Needs --recording.
     #[arg(long)]
     pub sensor_frf: Option<PathBuf>,
-}
-
-/// The parsed chain and a one-line description of it (for the recording's header and the JSON).
-#[derive(Debug, Clone)]
-pub struct SensorChain {
-    /// Chain per axis.
-    pub chain: MeasuringChain,
-    /// Human-readable description.
-    pub description: String,
-    /// JSON description.
-    pub json: serde_json::Value,
 }
 
 /// One value or three (x, y, z) from a comma list; `rigid` entries are `None`.
@@ -78,8 +58,8 @@ fn per_axis(flag: &str, text: &str, q: Quantity, what: &str) -> Result<[Option<f
 }
 
 impl SensorFlags {
-    /// The chain given by the flags, `None` when none was given (a rigid sensor).
-    pub fn chain(&self) -> Result<Option<SensorChain>> {
+    /// The sensor given by the flags, `None` when none was given (a rigid sensor).
+    pub fn request(&self) -> Result<Option<SensorRequest>> {
         if self.sensor_frf.is_some() && self.sensor_mode_hz.is_some() {
             bail!("--sensor-frf and --sensor-mode-hz: give one sensor chain, not both");
         }
@@ -89,111 +69,56 @@ impl SensorFlags {
             );
         }
         if let Some(path) = &self.sensor_frf {
-            let chain = runout_io::frf::read_frf(path).context("--sensor-frf")?;
-            let axes: Vec<&str> = ["x", "y", "z"]
-                .into_iter()
-                .zip([&chain.x, &chain.y, &chain.z])
-                .filter(|(_, c)| !c.is_rigid())
-                .map(|(a, _)| a)
-                .collect();
-            let description = format!(
-                "measured FRF {} on {} (other axes rigid)",
-                path.display(),
-                axes.join(" ")
-            );
-            let json = serde_json::json!({
-                "kind": "measured_frf",
-                "file": path.display().to_string(),
-                "axes": axes,
-                "oversample": OVERSAMPLE,
-            });
-            return Ok(Some(SensorChain {
-                chain,
-                description,
-                json,
-            }));
+            return Ok(Some(SensorRequest::Frf(Source::path(path))));
         }
         let Some(f_text) = &self.sensor_mode_hz else {
             return Ok(None);
         };
-        let f = per_axis(
+        let frequency_hz = per_axis(
             "--sensor-mode-hz",
             f_text,
             Quantity::FrequencyHz,
             "a natural frequency > 0 Hz (or `rigid`)",
         )?;
-        let z = match &self.sensor_damping {
-            Some(t) => per_axis(
-                "--sensor-damping",
-                t,
-                Quantity::Dimensionless,
-                "a damping ratio between 0 and 1",
-            )?,
-            None => [Some(0.03); 3],
-        };
-        let mut axes = [AxisChain::Rigid, AxisChain::Rigid, AxisChain::Rigid];
-        let mut parts = Vec::new();
-        let mut modes_json = Vec::new();
-        for (i, name) in ["x", "y", "z"].iter().enumerate() {
-            let Some(fn_hz) = f[i] else { continue };
-            let zeta = z[i].ok_or_else(|| {
-                anyhow::anyhow!("--sensor-damping: axis {name} has a mode at {fn_hz} Hz but damping `rigid`; expected a damping ratio between 0 and 1")
-            })?;
-            let mode = SensorMode::new(fn_hz, zeta, 1.0).map_err(|e| {
-                let flag = if e.param == "sensor_damping" {
-                    "--sensor-damping"
-                } else {
-                    "--sensor-mode-hz"
-                };
-                anyhow::anyhow!(
-                    "{flag} (axis {name}): expected {}, got {}",
-                    e.expected,
-                    e.got
+        let damping = self
+            .sensor_damping
+            .as_deref()
+            .map(|t| {
+                per_axis(
+                    "--sensor-damping",
+                    t,
+                    Quantity::Dimensionless,
+                    "a damping ratio between 0 and 1",
                 )
-            })?;
-            axes[i] = AxisChain::Modes(vec![mode]);
-            parts.push(format!("{name} {fn_hz} Hz zeta {zeta}"));
-            modes_json.push(serde_json::json!({
-                "axis": name,
-                "frequency_hz": fn_hz,
-                "damping": zeta,
-            }));
-        }
-        if parts.is_empty() {
-            bail!("--sensor-mode-hz: every axis is `rigid`; expected at least one natural frequency > 0 Hz");
-        }
-        let [x, y, zc] = axes;
-        Ok(Some(SensorChain {
-            chain: MeasuringChain { x, y, z: zc },
-            description: format!("second-order mode {} (other axes rigid)", parts.join(" / ")),
-            json: serde_json::json!({
-                "kind": "modes",
-                "modes": modes_json,
-                "oversample": OVERSAMPLE,
-            }),
+            })
+            .transpose()?;
+        Ok(Some(SensorRequest::Modes {
+            frequency_hz,
+            damping,
         }))
     }
-}
-
-/// Run one padded channel, sampled at `OVERSAMPLE·fs`, through `chain` and decimate it to `fs`.
-pub fn through_sensor(chain: &AxisChain, fs: f64, fine: &[f64]) -> Vec<f64> {
-    chain
-        .filter(fs * OVERSAMPLE as f64, fine)
-        .into_iter()
-        .step_by(OVERSAMPLE)
-        .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn flags(f: Option<&str>, z: Option<&str>) -> SensorFlags {
-        SensorFlags {
+    use runout::simulate::sensor::{chain, SensorChain};
+    use runout_core::chain::{AxisChain, SensorMode};
+
+    struct F(SensorFlags);
+    impl F {
+        fn chain(&self) -> Result<Option<SensorChain>> {
+            self.0.request()?.as_ref().map(chain).transpose()
+        }
+    }
+
+    fn flags(f: Option<&str>, z: Option<&str>) -> F {
+        F(SensorFlags {
             sensor_mode_hz: f.map(String::from),
             sensor_damping: z.map(String::from),
             sensor_frf: None,
-        }
+        })
     }
 
     #[test]

@@ -46,6 +46,11 @@ impl ArcAtHeight {
     pub fn radius_difference(&self, tooth: usize, m: usize) -> f64 {
         self.dr[tooth * self.k + m - 1]
     }
+
+    /// Feed f_{i,m} (mm) between the passes of tooth i−m and tooth i, `m` in `1..=K`.
+    pub fn feed(&self, tooth: usize, m: usize) -> f64 {
+        self.feed[tooth * self.k + m - 1]
+    }
 }
 
 impl ChipThickness for ArcChip {

@@ -11,6 +11,7 @@ use super::closed_form::{pass_terms, EquivalentParams};
 use super::exact::{exact_at, NewtonOptions, Ray};
 use super::kinematics::{ToolKinematics, ToolMotion};
 use crate::error::ParamError;
+use crate::fit::LinearLsq;
 use nalgebra::{DMatrix, DVector};
 
 /// A calibration point: tooth, height z (mm), time t (s).
@@ -99,11 +100,9 @@ fn solve_rows(rows: &[[f64; 3]], phase_refinement: bool) -> Result<CompensationF
             rows.len(),
         ));
     }
-    let a = DMatrix::from_fn(rows.len(), 2, |r, c| rows[r][c]);
+    let lsq = LinearLsq::new(DMatrix::from_fn(rows.len(), 2, |r, c| rows[r][c]));
     let b = DVector::from_fn(rows.len(), |r, _| rows[r][2]);
-    let svd = a.clone().svd(true, true);
-    let (smax, smin) = (svd.singular_values.max(), svd.singular_values.min());
-    let condition = smax / smin;
+    let condition = lsq.condition();
     if !(condition.is_finite() && condition < 1e8) {
         return Err(ParamError::new(
             "calibration_points",
@@ -111,15 +110,14 @@ fn solve_rows(rows: &[[f64; 3]], phase_refinement: bool) -> Result<CompensationF
             format!("condition {condition:.3e}"),
         ));
     }
-    let k = svd.solve(&b, 1e-14).map_err(|e| {
+    let fit = lsq.solve(&b, 1e-14).map_err(|e| {
         ParamError::new("calibration_points", "a solvable least-squares problem", e)
     })?;
-    let resid = &a * &k - &b;
-    let rss = resid.norm_squared();
+    let (k, rss) = (&fit.beta, fit.rss);
     // covariance σ²(AᵀA)⁻¹ with σ² = RSS/(n − 2)
     let sigma2 = rss / (rows.len() as f64 - 2.0);
-    let cov = (a.transpose() * &a)
-        .try_inverse()
+    let cov = lsq
+        .normal_inverse()
         .map(|inv| inv * sigma2)
         .unwrap_or_else(|| DMatrix::from_element(2, 2, f64::INFINITY));
     Ok(CompensationFit {

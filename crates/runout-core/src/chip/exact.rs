@@ -282,7 +282,7 @@ pub fn ray_crossing<M: ToolMotion>(
 /// use runout_core::chip::*;
 /// use runout_core::{Cutter, Runout};
 /// // methods.md §7: App. A.3 defaults, edge 0, z = 5, t = T + (5/48)T → 92.987 µm
-/// let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+/// let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
 /// let runout = Runout::new(0.010, 40f64.to_radians()).unwrap();
 /// let motion = StraightFeed { p0: Vec3::zeros(), v: Vec3::new(40.0, 0.0, 0.0), u: Vec3::z(), e1: Vec3::x() };
 /// let kin = ToolKinematics::new(&cutter, &runout, 6000.0, 0.0, SpindleSense::CounterClockwise, motion).unwrap();

@@ -44,7 +44,7 @@ fn axpy(a: f64, x: Plane, y: Plane) -> Plane {
 /// ```
 /// use runout_core::chip::*;
 /// use runout_core::{Cutter, Runout};
-/// let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+/// let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
 /// let runout = Runout::new(0.010, 40f64.to_radians()).unwrap();
 /// let swing = ConstantSwing::new(Vec3::new(40.0, 0.0, 0.0), Vec3::y(), 1.0, 0.0).unwrap();
 /// let kin = ToolKinematics::new(&cutter, &runout, 6000.0, 0.0, SpindleSense::Clockwise, swing).unwrap();
@@ -100,7 +100,7 @@ struct HeightTable {
 /// use runout_core::{Cutter, Runout};
 /// // methods.md §7: App. A.3 defaults, edge 0, z = 5, t = T + (5/48)T; the equivalent model
 /// // with phase refinement gives 92.99 µm (exact 92.987 µm)
-/// let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+/// let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
 /// let runout = Runout::new(0.010, 40f64.to_radians()).unwrap();
 /// let motion = StraightFeed { p0: Vec3::zeros(), v: Vec3::new(40.0, 0.0, 0.0), u: Vec3::z(), e1: Vec3::x() };
 /// let kin = ToolKinematics::new(&cutter, &runout, 6000.0, 0.0, SpindleSense::CounterClockwise, motion).unwrap();
@@ -265,7 +265,7 @@ impl<'k, M: ToolMotion> EquivalentEvaluator<'k, M> {
 /// ```
 /// use runout_core::chip::*;
 /// use runout_core::{Cutter, Runout};
-/// let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+/// let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
 /// let kin = ToolKinematics::new(&cutter, &Runout::none(), 6000.0, 0.0,
 ///     SpindleSense::Clockwise, StraightFeed::along_x(40.0)).unwrap();
 /// let eval = EquivalentEvaluator::new(&kin, &[5.0], EquivalentParams::default());

@@ -22,6 +22,7 @@ use super::estimate::{polar_with_covariance, AngleEstimate, NoiseSource};
 use super::readings::ToothReadings;
 use crate::angle::wrap_pi;
 use crate::cutter::Cutter;
+use crate::fit::LinearLsq;
 use crate::runout::Runout;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn, Matrix2, Matrix3, OMatrix, Vector3, U3};
@@ -261,7 +262,7 @@ fn linear_start(cutter: &Cutter, z: f64, p: &[f64], w: &[f64]) -> Option<Vector3
         w[i] * [1.0, psi.cos(), psi.sin()][c]
     });
     let b = DVector::from_iterator(k, (0..k).map(|i| w[i] * (p[i] - r)));
-    let x = a.svd(true, true).solve(&b, 1e-12).ok()?;
+    let x = LinearLsq::new(a).beta(&b, 1e-12).ok()?;
     Some(Vector3::new(x[0], x[1], x[2]))
 }
 

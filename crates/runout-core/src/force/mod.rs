@@ -13,12 +13,14 @@
 //!
 //! and the spindle torque is T = Σ dF_t·R_i(z_j). Edge forces act only where h > 0.
 
+#[doc(hidden)]
+pub mod baseline;
+pub(crate) mod kernel;
 mod peaks;
 
 pub use peaks::{tooth_peaks, ToothPeak};
 
-use crate::angle::wrap_tau;
-use crate::chip::{ChipAtHeight, ChipThickness};
+use crate::chip::{ArcChip, ChipThickness};
 use crate::coefficients::CuttingCoefficients;
 use crate::cut::Cut;
 use crate::cutter::Cutter;
@@ -26,6 +28,7 @@ use crate::edge::EdgeTable;
 use crate::error::{positive, ParamError};
 use crate::runout::Runout;
 use rayon::prelude::*;
+use std::any::Any;
 use std::f64::consts::TAU;
 
 /// Angular sampling and axial discretisation of a simulation.
@@ -149,25 +152,6 @@ impl ForceSeries {
     }
 }
 
-/// Per (disk, tooth) runout-dependent radius next to the shared [`EdgeTable`] geometry.
-struct Slice {
-    cos_psi: f64,
-    sin_psi: f64,
-    psi: f64,
-    radius: f64,
-}
-
-/// Per-disk constants of the kernel.
-#[derive(Clone, Copy)]
-struct DiskConst {
-    entry: f64,
-    width: f64,
-    sin_kappa: f64,
-    cos_kappa: f64,
-    dz: f64,
-    db: f64,
-}
-
 impl ForceModel {
     /// Simulate the forces with chip model `chip` over `sampling`.
     ///
@@ -200,7 +184,17 @@ impl ForceModel {
     /// let peak = s.fxy().into_iter().fold(0.0, f64::max);
     /// assert!((peak - 247.361).abs() < 0.02);
     /// ```
-    pub fn simulate<C: ChipThickness>(&self, chip: &C, sampling: &Sampling) -> ForceSeries {
+    ///
+    /// Evaluated by the shared kernel (`force::kernel`, issue 18) that also computes the basis
+    /// sums of [`crate::identify::RevolutionModel`]: engagement, chip and sin/cos φ of every
+    /// element once, contracted here with the coefficients per element (the forces above, in
+    /// the same arithmetic as before the kernel was shared, so results are unchanged bit for bit). The arc chip ([`ArcChip`]) is evaluated in SIMD lanes; any other chip model
+    /// through its scalar [`crate::ChipAtHeight`] evaluator, one call per lane.
+    pub fn simulate<C: ChipThickness + 'static>(
+        &self,
+        chip: &C,
+        sampling: &Sampling,
+    ) -> ForceSeries {
         let table = EdgeTable::new(&self.cutter, &self.cut, sampling.disks);
         if table.is_flat() {
             self.simulate_table::<C, false>(chip, sampling, &table)
@@ -211,129 +205,120 @@ impl ForceModel {
 
     /// Always the κ(z) kernel, also on a cylinder: for verification and benchmarks (on a flat
     /// end mill it equals [`ForceModel::simulate`], which takes the cheaper path there).
-    pub fn simulate_general<C: ChipThickness>(&self, chip: &C, sampling: &Sampling) -> ForceSeries {
+    pub fn simulate_general<C: ChipThickness + 'static>(
+        &self,
+        chip: &C,
+        sampling: &Sampling,
+    ) -> ForceSeries {
         let table = EdgeTable::new(&self.cutter, &self.cut, sampling.disks);
         self.simulate_table::<C, true>(chip, sampling, &table)
     }
 
-    /// The kernel; `GENERAL = false` only when κ = 90° on every disk (then sin κ = 1, cos κ = 0
-    /// and db = dz, and the κ terms are left out of the inner loop).
-    fn simulate_table<C: ChipThickness, const GENERAL: bool>(
+    fn simulate_table<C: ChipThickness + 'static, const GENERAL: bool>(
         &self,
         chip: &C,
         sampling: &Sampling,
         table: &EdgeTable,
     ) -> ForceSeries {
-        let k = self.cutter.teeth();
+        let k = table.teeth();
+        let sim = kernel::SimConsts {
+            radius: table
+                .disks()
+                .iter()
+                .flat_map(|d| (0..k).map(move |i| self.runout.tooth_radius(&self.cutter, i, d.z)))
+                .collect(),
+            kc: self.coefficients,
+        };
+        if let Some(arc) = (chip as &dyn Any).downcast_ref::<ArcChip>() {
+            let mut lanes = kernel::ArcLanes {
+                k,
+                feed: Vec::with_capacity(table.len() * k * k),
+                dr: Vec::with_capacity(table.len() * k * k),
+                dnx: Vec::new(),
+                dny: Vec::new(),
+            };
+            for d in table.disks() {
+                let ev = arc.at_height(d.z);
+                for i in 0..k {
+                    for m in 1..=k {
+                        lanes.feed.push(ev.feed(i, m));
+                        lanes.dr.push(ev.radius_difference(i, m));
+                    }
+                }
+            }
+            self.run_kernel::<_, GENERAL>(&lanes, sampling, table, &sim)
+        } else {
+            let lanes =
+                kernel::ScalarLanes(table.disks().iter().map(|d| chip.at_height(d.z)).collect());
+            self.run_kernel::<_, GENERAL>(&lanes, sampling, table, &sim)
+        }
+    }
+
+    /// Blocks of [`CHUNK`] samples in parallel (rayon), each through the shared kernel.
+    fn run_kernel<L: kernel::LaneChip, const GENERAL: bool>(
+        &self,
+        lanes: &L,
+        sampling: &Sampling,
+        table: &EdgeTable,
+        sim: &kernel::SimConsts,
+    ) -> ForceSeries {
+        let k = table.teeth();
         let n = sampling.samples();
         let omega = self.cut.omega();
-
-        let evaluators: Vec<C::AtHeight> =
-            table.disks().iter().map(|d| chip.at_height(d.z)).collect();
-        let consts: Vec<DiskConst> = table
-            .disks()
-            .iter()
-            .map(|d| DiskConst {
-                entry: d.entry,
-                width: d.width,
-                sin_kappa: d.sin_kappa,
-                cos_kappa: d.cos_kappa,
-                dz: d.dz,
-                db: d.db,
-            })
-            .collect();
-        let slices: Vec<Slice> = table
-            .disks()
-            .iter()
-            .enumerate()
-            .flat_map(|(j, d)| {
-                table
-                    .elements(j)
-                    .iter()
-                    .enumerate()
-                    .map(move |(i, el)| Slice {
-                        cos_psi: el.cos_psi,
-                        sin_psi: el.sin_psi,
-                        psi: el.psi,
-                        radius: self.runout.tooth_radius(&self.cutter, i, d.z),
-                    })
-            })
-            .collect();
-        let kc = self.coefficients;
-
+        let arch = pulp::Arch::new();
         let mut out = vec![[0.0f64; 4]; n];
         let mut chip_out = vec![0.0f64; n * k];
-        const CHUNK: usize = 2048;
         let (max_chip, own_peak) = out
             .par_chunks_mut(CHUNK)
             .zip(chip_out.par_chunks_mut(CHUNK * k))
             .enumerate()
             .map(|(c, (out, chip_out))| {
-                let mut max_chip = vec![0.0f64; k];
-                let mut own_peak = vec![0.0f64; k];
-                let mut own = vec![[0.0f64; 2]; k];
-                for (q, o) in out.iter_mut().enumerate() {
-                    let theta = sampling.step * (c * CHUNK + q) as f64;
-                    let (st_theta, ct_theta) = theta.sin_cos();
-                    let mut f = [0.0f64; 4];
-                    own.iter_mut().for_each(|v| *v = [0.0; 2]);
-                    for (j, (ev, dc)) in evaluators.iter().zip(&consts).enumerate() {
-                        let dz = dc.dz;
-                        let st = dc.entry;
-                        let width = dc.width;
-                        for (i, sl) in slices[j * k..(j + 1) * k].iter().enumerate() {
-                            let rel = wrap_tau(theta + sl.psi - st);
-                            if rel > width {
-                                continue;
-                            }
-                            let phi = st + rel;
-                            // sin/cos of θ+ψ by the addition theorem: no trig in the inner loop.
-                            let s = st_theta * sl.cos_psi + ct_theta * sl.sin_psi;
-                            let co = ct_theta * sl.cos_psi - st_theta * sl.sin_psi;
-                            let h_arc = ev.thickness(i, phi, s, co);
-                            let h = if GENERAL { h_arc * dc.sin_kappa } else { h_arc };
-                            if j == 0 {
-                                chip_out[q * k + i] = h;
-                            }
-                            if h <= 0.0 {
-                                continue;
-                            }
-                            max_chip[i] = max_chip[i].max(h);
-                            let (ft, frad, fax) = if GENERAL {
-                                // K_c·(h sin κ)·db integrates to K_c·h_arc·dz (h_arc = h/sin κ)
-                                let hz = h_arc * dz;
-                                let db = dc.db;
-                                let ft = kc.ktc * hz + kc.kte * db;
-                                let fr = kc.krc * hz + kc.kre * db;
-                                let fa = kc.kac * hz + kc.kae * db;
-                                (
-                                    ft,
-                                    fr * dc.sin_kappa - fa * dc.cos_kappa,
-                                    fr * dc.cos_kappa + fa * dc.sin_kappa,
-                                )
-                            } else {
-                                (
-                                    (kc.ktc * h + kc.kte) * dz,
-                                    (kc.krc * h + kc.kre) * dz,
-                                    (kc.kac * h + kc.kae) * dz,
-                                )
-                            };
-                            let dx = ft * co + frad * s;
-                            let dy = -ft * s + frad * co;
-                            f[0] += dx;
-                            f[1] += dy;
-                            f[2] -= fax;
-                            f[3] += ft * sl.radius;
-                            own[i][0] += dx;
-                            own[i][1] += dy;
-                        }
-                    }
-                    f[3] *= 1e-3; // N·mm → N·m
-                    *o = f;
-                    for (p, v) in own_peak.iter_mut().zip(&own) {
-                        *p = p.max(v[0].hypot(v[1]));
+                let len = out.len();
+                let grid = kernel::Grid::new(
+                    (0..len).map(|q| sampling.step * (c * CHUNK + q) as f64),
+                    sampling.step,
+                    false,
+                );
+                let mut acc = kernel::Acc::new(kernel::padded(len), GENERAL, 0, Some(k));
+                let opts = kernel::Options {
+                    edge_in_window: false,
+                    np: 0,
+                };
+                kernel::dispatch::<L, GENERAL, true>(
+                    arch,
+                    table,
+                    lanes,
+                    &grid,
+                    0..table.len(),
+                    opts,
+                    Some(sim),
+                    &mut acc,
+                );
+                let stride = acc.stride;
+                let f = &acc.force;
+                for (t, o) in out.iter_mut().enumerate() {
+                    *o = [
+                        f[t],
+                        f[stride + t],
+                        f[2 * stride + t],
+                        f[3 * stride + t] * 1e-3, // N·mm → N·m
+                    ];
+                    for i in 0..k {
+                        chip_out[t * k + i] = acc.chip[i * stride + t];
                     }
                 }
+                let own_peak: Vec<f64> = (0..k)
+                    .map(|i| {
+                        let x = &acc.own[2 * i * stride..2 * i * stride + len];
+                        let y = &acc.own[(2 * i + 1) * stride..(2 * i + 1) * stride + len];
+                        x.iter().zip(y).fold(0.0f64, |p, (x, y)| p.max(x.hypot(*y)))
+                    })
+                    .collect();
+                let max_chip: Vec<f64> = acc
+                    .max_chip
+                    .iter()
+                    .map(|v| v.iter().fold(0.0f64, |a, b| a.max(*b)))
+                    .collect();
                 (max_chip, own_peak)
             })
             .reduce(
@@ -364,3 +349,6 @@ impl ForceModel {
         }
     }
 }
+
+/// Samples per parallel block of a simulation.
+const CHUNK: usize = 2048;

@@ -2,6 +2,7 @@
 //! bar axis (offset + tilt) and the residual form error (methods.md §5.2, §5.5).
 
 use super::probe::{Layer, ProbeGrid};
+use crate::fit::LinearLsq;
 use nalgebra::{DMatrix, DVector};
 
 /// Deviations of one layer.
@@ -116,13 +117,12 @@ fn layer_deviation(l: &Layer) -> LayerDeviation {
         _ => l.alpha[j].sin(),
     });
     let b = DVector::from_column_slice(&l.radius);
-    let svd = a.clone().svd(true, true);
-    let sv = &svd.singular_values;
-    let condition = sv.max() / sv.min();
-    let x = svd
-        .solve(&b, 1e-12 * sv.max())
+    let lsq = LinearLsq::new(a);
+    let condition = lsq.condition();
+    let x = lsq
+        .beta(&b, 1e-12 * lsq.smax())
         .unwrap_or_else(|_| DVector::from_element(3, f64::NAN));
-    let res = &b - &a * &x;
+    let res = &b - lsq.design() * &x;
     let form_rms = (res.norm_squared() / n as f64).sqrt();
     let form_max = res.amax();
     LayerDeviation {
@@ -142,20 +142,24 @@ fn layer_deviation(l: &Layer) -> LayerDeviation {
 /// Least squares of (c_i, s_i) on [1, u_i].
 fn fit_axis(layers: &[LayerDeviation]) -> AxisFit {
     let m = layers.len();
-    let a = DMatrix::from_fn(m, 2, |i, k| if k == 0 { 1.0 } else { layers[i].u });
+    let lsq = LinearLsq::new(DMatrix::from_fn(m, 2, |i, k| {
+        if k == 0 {
+            1.0
+        } else {
+            layers[i].u
+        }
+    }));
     let mut coef = [[0.0; 2]; 2]; // [component][intercept, slope]
     let mut resid = vec![[0.0; 2]; m];
     let mut rss = [0.0; 2];
-    let ata_inv = (a.transpose() * &a).try_inverse();
+    let ata_inv = lsq.normal_inverse();
     for comp in 0..2 {
         let b = DVector::from_iterator(m, layers.iter().map(|l| if comp == 0 { l.c } else { l.s }));
-        let x = a
-            .clone()
-            .svd(true, true)
-            .solve(&b, 1e-14)
+        let x = lsq
+            .beta(&b, 1e-14)
             .unwrap_or_else(|_| DVector::from_element(2, f64::NAN));
         coef[comp] = [x[0], x[1]];
-        let r = &b - &a * &x;
+        let r = &b - lsq.design() * &x;
         for i in 0..m {
             resid[i][comp] = r[i];
         }

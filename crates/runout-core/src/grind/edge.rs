@@ -120,7 +120,7 @@ impl EdgeLine {
     ) -> Result<Self, ParamError> {
         check_range(z0, z1, n)?;
         crate::limits::result_size("points_per_flute", flutes as f64 * n as f64, 8.0)?;
-        let cutter = Cutter::flat(diameter_mm, flutes, helix_deg)?;
+        let cutter = Cutter::flat(diameter_mm, flutes, helix_deg.to_radians())?;
         Ok(EdgeLine {
             points: sample(&cutter, z0, z1, n),
             kind: EdgeKind::Peripheral,
@@ -141,7 +141,13 @@ impl EdgeLine {
         crate::limits::teeth("flutes", flutes)?;
         crate::limits::result_size("points_per_flute", flutes as f64 * n as f64, 8.0)?;
         let pitch = vec![TAU / flutes as f64; flutes];
-        let cutter = Cutter::new(diameter_mm, pitch, helix_deg, z1, RadiusProfile::Ball)?;
+        let cutter = Cutter::new(
+            diameter_mm,
+            pitch,
+            helix_deg.to_radians(),
+            z1,
+            RadiusProfile::Ball,
+        )?;
         Ok(EdgeLine {
             points: sample(&cutter, z0, z1, n),
             kind: EdgeKind::Ball {

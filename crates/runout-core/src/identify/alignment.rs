@@ -14,9 +14,10 @@
 //!    parabola through the best three points give θ₀ to a small fraction of a degree.
 
 use super::model::{coefficient_gradient, force_from_basis, RevolutionModel};
-use super::waveform::{Axis, WaveformCase};
+use super::waveform::{FrameAxis, WaveformCase};
 use crate::angle::wrap_pi;
 use crate::coefficients::CuttingCoefficients;
+use crate::fit::{fourier_coefficient, LinearLsq};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::TAU;
 
@@ -46,15 +47,16 @@ pub fn model_forces(
             .map(|s| force_from_basis(ax, s, kc))
             .collect::<Vec<_>>()
     };
-    [f(Axis::X), f(Axis::Y), f(Axis::Z)]
+    [f(FrameAxis::X), f(FrameAxis::Y), f(FrameAxis::Z)]
 }
 
+/// k-th Fourier coefficient of one revolution of bins ([`fourier_coefficient`]).
 fn harmonic(v: &[f64], k: usize) -> (f64, f64) {
     let n = v.len() as f64;
-    v.iter().enumerate().fold((0.0, 0.0), |(re, im), (j, x)| {
-        let a = TAU * (k * j) as f64 / n;
-        (re + x * a.cos(), im - x * a.sin())
-    })
+    fourier_coefficient(
+        v.iter().copied(),
+        (0..v.len()).map(|j| TAU * (k * j) as f64 / n),
+    )
 }
 
 /// θ₀ from the tooth-passing harmonic of the measured F_x, F_y against the model with runout `e`,
@@ -62,15 +64,15 @@ fn harmonic(v: &[f64], k: usize) -> (f64, f64) {
 ///
 /// ```
 /// use runout_core::*;
-/// use runout_core::identify::{harmonic_start_angle, AveragedWaveform, Axis, WaveformCase};
-/// let cutter = Cutter::flat(10.0, 4, 30.0).unwrap();
+/// use runout_core::identify::{harmonic_start_angle, AveragedWaveform, FrameAxis, WaveformCase};
+/// let cutter = Cutter::flat(10.0, 4, 30.0f64.to_radians()).unwrap();
 /// let cut = Cut::new(3000.0, 0.08, 2.0).unwrap().radial(2.0, MillingMode::Down, &cutter).unwrap();
 /// let kc = CuttingCoefficients::new([2000.0, 800.0, 300.0], [60.0, 100.0, 0.0]).unwrap();
 /// let m = ForceModel { cutter: cutter.clone(), runout: Runout::none(), cut, coefficients: kc };
 /// let s = m.simulate(&ArcChip::new(&cutter, &Runout::none(), 0.08).unwrap(), &Sampling::new(1.0, 1.0, 400).unwrap());
 /// // the same revolution seen from bin 0 at θ = 37°
 /// let rot = |v: &[f64]| (0..360).map(|j| v[(j + 37) % 360]).collect::<Vec<_>>();
-/// let w = AveragedWaveform::average(0.0, 360, &[(Axis::X, &rot(&s.fx)), (Axis::Y, &rot(&s.fy))]).unwrap();
+/// let w = AveragedWaveform::average(0.0, 360, &[(FrameAxis::X, &rot(&s.fx)), (FrameAxis::Y, &rot(&s.fy))]).unwrap();
 /// let case = WaveformCase { cutter, cut, waveform: w };
 /// // the harmonic estimate is approximate (edge-force steps, disk discretisation): within 0.1°
 /// let t0 = harmonic_start_angle(&case, [0.0; 2], [0.0; 2], &kc, 0.6);
@@ -91,9 +93,9 @@ pub fn harmonic_start_angle(
     let (mut re, mut im) = (0.0, 0.0);
     for c in &case.waveform.components {
         let p = match c.axis {
-            Axis::X => &model[0],
-            Axis::Y => &model[1],
-            Axis::Z => continue,
+            FrameAxis::X => &model[0],
+            FrameAxis::Y => &model[1],
+            FrameAxis::Z => continue,
         };
         let (mr, mi) = harmonic(&c.values, k);
         let (pr, pi) = harmonic(p, k);
@@ -135,10 +137,10 @@ fn lsq_rss<const P: usize>(rows: &[[f64; P]], y: &[f64]) -> f64 {
     if rows.is_empty() {
         return 0.0;
     }
-    let x = DMatrix::from_fn(rows.len(), P, |r, c| rows[r][c]);
+    let lsq = LinearLsq::new(DMatrix::from_fn(rows.len(), P, |r, c| rows[r][c]));
     let yv = DVector::from_column_slice(y);
-    match x.clone().svd(true, true).solve(&yv, 1e-12) {
-        Ok(beta) => (yv - x * beta).norm_squared(),
+    match lsq.solve(&yv, 1e-12) {
+        Ok(fit) => fit.rss,
         Err(_) => yv.norm_squared(),
     }
 }

@@ -43,6 +43,19 @@ pub enum IdentifyError {
     },
 }
 
+impl From<crate::fit::FitError> for IdentifyError {
+    fn from(e: crate::fit::FitError) -> Self {
+        match e {
+            crate::fit::FitError::TooFewData { what, needed, got } => {
+                IdentifyError::TooFewData { what, needed, got }
+            }
+            crate::fit::FitError::Singular { what, reason } => {
+                IdentifyError::Singular { what, reason }
+            }
+        }
+    }
+}
+
 impl IdentifyError {
     /// Shorthand for [`IdentifyError::TooFewData`].
     pub(crate) fn too_few(what: &str, needed: impl ToString, got: impl ToString) -> Self {

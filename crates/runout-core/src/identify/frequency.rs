@@ -16,10 +16,10 @@
 //! A single DFT bin is a direct O(N) sum — cheaper than an FFT of the whole revolution.
 
 use super::error::IdentifyError;
-use super::lsq::linear_lsq;
 use super::model::{force_from_basis, runout_gradient, RevolutionModel};
 use super::waveform::WaveformCase;
 use crate::coefficients::CuttingCoefficients;
+use crate::fit::{fourier_coefficient, linear_lsq, FitError};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
@@ -36,11 +36,9 @@ pub struct FrequencyEstimate {
     pub relative_residual: f64,
 }
 
-/// First Fourier coefficient Σ v_q e^{−jθ_q} as (re, im).
+/// First Fourier coefficient Σ v_q e^{−jθ_q} as (re, im) ([`fourier_coefficient`]).
 fn first_harmonic(values: impl Iterator<Item = f64>, angles: &[f64]) -> (f64, f64) {
-    values.zip(angles).fold((0.0, 0.0), |(re, im), (v, t)| {
-        (re + v * t.cos(), im - v * t.sin())
-    })
+    fourier_coefficient(values, angles.iter().copied())
 }
 
 /// Estimate the runout vector from the spindle-frequency harmonic of the averaged waveforms,
@@ -87,7 +85,7 @@ pub fn frequency_estimate(
     let x = DMatrix::from_fn(rows.len(), 2, |r, c| rows[r][c]);
     let y = DVector::from_vec(rhs);
     let fit = linear_lsq("frequency-domain runout estimate", &x, &y).map_err(|e| match e {
-        IdentifyError::Singular { what, reason } => IdentifyError::Singular {
+        FitError::Singular { what, reason } => IdentifyError::Singular {
             what,
             reason: format!(
                 "{reason}: one direction of the runout vector does not change the spindle \
@@ -95,7 +93,7 @@ pub fn frequency_estimate(
                  is observable)"
             ),
         },
-        other => other,
+        other => other.into(),
     })?;
     let e = [fit.beta[0], fit.beta[1]];
     Ok(FrequencyEstimate {

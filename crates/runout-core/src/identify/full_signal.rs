@@ -32,13 +32,13 @@ use super::covariance::{fit_covariance, time_blocks_to_harmonics, FitCovariance}
 use super::error::IdentifyError;
 use super::frequency::{frequency_estimate, FrequencyEstimate};
 use super::harmonic_fit::{harmonic_fit, ChainFitReport, ChainOptions};
-use super::lsq::linear_lsq;
 use super::model::{
     coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel,
 };
 use super::sine_fit::Estimate;
-use super::waveform::{Axis, WaveformCase};
+use super::waveform::{FrameAxis, WaveformCase};
 use crate::coefficients::CuttingCoefficients;
+use crate::fit::linear_lsq;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
 use serde::Serialize;
@@ -174,7 +174,7 @@ fn runout_observability(p: &mut Problem<'_>) -> RunoutObservability {
 fn fitted_coefficients(cases: &[WaveformCase]) -> Vec<usize> {
     let has_z = cases
         .iter()
-        .any(|c| c.waveform.components.iter().any(|k| k.axis == Axis::Z));
+        .any(|c| c.waveform.components.iter().any(|k| k.axis == FrameAxis::Z));
     if has_z {
         vec![0, 1, 2, 3, 4, 5]
     } else {
@@ -586,20 +586,14 @@ pub(crate) const RUNOUT_STEP_UM: f64 = 0.1;
 
 pub(crate) const NAMES: [&str; 6] = ["ktc", "krc", "kac", "kte", "kre", "kae"];
 
-/// Identify runout (and tilt) and the cutting coefficients from averaged waveforms.
+/// Identify runout (and tilt) and the cutting coefficients from averaged waveforms: check the
+/// cases, set up the problem, pick start values, fit locally (LM on the smooth model, then a
+/// pattern search on the exact one), and summarise with the robust covariance.
 pub fn full_signal_fit(
     cases: &[WaveformCase],
     options: &FullSignalOptions,
 ) -> Result<FullSignalFit, IdentifyError> {
-    if cases.is_empty() {
-        return Err(IdentifyError::too_few("full-signal fit", "1 recording", 0));
-    }
-    for c in cases {
-        c.waveform.validate()?;
-    }
-    let weights = cases
-        .iter()
-        .all(|c| c.waveform.components.iter().all(|k| k.se.is_some()));
+    let weights = validate_cases(cases)?;
     let disks = options
         .disks
         .unwrap_or_else(|| auto_disks(cases, options.fit_tilt))
@@ -607,8 +601,78 @@ pub fn full_signal_fit(
     if let Some(chain) = &options.chain {
         return harmonic_fit(cases, options, chain, disks);
     }
+    let mut problem = new_problem(cases, options.fit_tilt, disks, weights);
+    let np_full = problem.x.len();
+    let n = problem.n_residuals();
+    if n <= np_full {
+        return Err(IdentifyError::too_few(
+            "full-signal fit",
+            format!("more than {np_full} samples"),
+            n,
+        ));
+    }
+    let (e_start, initial) = start_values(&mut problem, options, disks)?;
+    // Observability of the runout direction: with K = 2 straight flutes the offset across the
+    // tooth line changes no radius difference (methods.md §4.2/§1.5 mirror ambiguity).
+    let observability = runout_observability(&mut problem);
+    let nr = problem.n_runout();
+    let np = problem.x.len();
+    let mut candidates = vec![e_start];
+    if let Some(f) = initial {
+        candidates.push(f.vector);
+    }
+    candidates.extend(candidate_runouts(&candidates));
+    let (mut problem, report) = local_fit(problem, candidates)?;
+    let cov = covariance_at_solution(&mut problem, cases)?;
+    let rss: f64 = problem.raw_residuals().iter().map(|r| r * r).sum();
+    let (e, tau) = problem.runout();
+    let coef_idx = problem.coef_idx.clone();
+    let mut coefficients = [0.0; 6];
+    let mut coefficient_se = [None; 6];
+    for (p, &i) in coef_idx.iter().enumerate() {
+        coefficients[i] = problem.x[nr + p];
+        coefficient_se[i] = Some(cov.se(nr + p));
+    }
+    Ok(fit_summary(FitSummaryInput {
+        e,
+        tau: options.fit_tilt.then_some(tau),
+        cov: &cov,
+        runout_dirs: &problem.dirs,
+        coefficients,
+        coefficient_se,
+        parameters: parameter_names(problem.dirs.len(), options.fit_tilt, &coef_idx),
+        rss,
+        tss: total_sum_of_squares(cases),
+        n,
+        np,
+        evaluations: report.number_of_evaluations,
+        termination: format!("{:?}", report.termination),
+        converged: report.termination.was_successful(),
+        initial,
+        disks,
+        observability,
+        has_z: coef_idx.len() == 6,
+    }))
+}
+
+/// At least one case, each waveform valid; returns whether every component carries standard
+/// errors (then the residuals are weighted by them).
+fn validate_cases(cases: &[WaveformCase]) -> Result<bool, IdentifyError> {
+    if cases.is_empty() {
+        return Err(IdentifyError::too_few("full-signal fit", "1 recording", 0));
+    }
+    for c in cases {
+        c.waveform.validate()?;
+    }
+    Ok(cases
+        .iter()
+        .all(|c| c.waveform.components.iter().all(|k| k.se.is_some())))
+}
+
+/// The least-squares problem at zero parameters: one revolution model per case.
+fn new_problem(cases: &[WaveformCase], fit_tilt: bool, disks: usize, weights: bool) -> Problem<'_> {
     let coef_idx = fitted_coefficients(cases);
-    let nr_full = if options.fit_tilt { 4 } else { 2 };
+    let nr_full = if fit_tilt { 4 } else { 2 };
     let np_full = nr_full + coef_idx.len();
     let models: Vec<RevolutionModel> = cases
         .iter()
@@ -622,55 +686,52 @@ pub fn full_signal_fit(
             )
         })
         .collect();
-    let mut problem = Problem {
+    Problem {
         cases,
         models,
-        coef_idx: coef_idx.clone(),
-        fit_tilt: options.fit_tilt,
+        coef_idx,
+        fit_tilt,
         dirs: vec![[1.0, 0.0], [0.0, 1.0]],
         x: DVector::zeros(np_full),
         sums: Vec::new(),
         weights,
         analytic: false,
-    };
-    let n = problem.n_residuals();
-    if n <= np_full {
-        return Err(IdentifyError::too_few(
-            "full-signal fit",
-            format!("more than {np_full} samples"),
-            n,
-        ));
     }
-    // Start values: the frequency-domain estimate (§4.7) and the caller's guess, then a coarse
-    // scan of the runout vector (16 angles × 3 offsets around the estimate) with the exactly
-    // solved coefficients at each point; LM runs from the best (and from the second best when its cost is within 2×) — with edge skipping (large ρ,
-    // K = 2) the cost has local minima the frequency estimate alone can fall into.
-    linear_coefficients(&mut problem)?;
+}
+
+/// Start values: the frequency-domain estimate (§4.7) unless the caller gave a runout, with the
+/// coefficients solved exactly there. Returns the start runout and the frequency estimate.
+fn start_values(
+    problem: &mut Problem<'_>,
+    options: &FullSignalOptions,
+    disks: usize,
+) -> Result<([f64; 2], Option<FrequencyEstimate>), IdentifyError> {
+    linear_coefficients(problem)?;
     let mut initial = None;
     let mut e_start = options.initial_runout.unwrap_or([0.0, 0.0]);
-    if let Ok(f) = frequency_estimate(cases, &problem.coefficients(), disks) {
+    if let Ok(f) = frequency_estimate(problem.cases, &problem.coefficients(), disks) {
         initial = Some(f);
         if options.initial_runout.is_none() {
             e_start = f.vector;
         }
     }
     problem.set_runout(e_start);
-    linear_coefficients(&mut problem)?;
-    // Observability of the runout direction: with K = 2 straight flutes the offset across the
-    // tooth line changes no radius difference (methods.md §4.2/§1.5 mirror ambiguity).
-    let observability = runout_observability(&mut problem);
-    let nr = problem.n_runout();
-    let np = problem.x.len();
-    let mut candidates = vec![e_start];
-    if let Some(f) = initial {
-        candidates.push(f.vector);
-    }
-    candidates.extend(candidate_runouts(&candidates));
-    // Stage 1 on the smooth variant of the model (edge forces over the whole engagement window,
-    // continuous in e): scan, then LM. Stage 2: derivative-free pattern search on the exact model
-    // (edge forces only where h > 0, as the simulation) from the stage-1 solution. With straight
-    // flutes the exact model's residuals jump by K_e·a_p where a tooth's chip crosses 0 and LM
-    // stalls there (round trip K = 6, ρ = 28 µm: 3 µm off; K = 3, ρ = 3 µm: 0.16 µm off).
+    linear_coefficients(problem)?;
+    Ok((e_start, initial))
+}
+
+/// Stage 1 on the smooth variant of the model (edge forces over the whole engagement window,
+/// continuous in e): a scan of the candidate runouts with the exactly solved coefficients at each,
+/// then LM from the best (and from the second best when its cost is within 2×) — with edge
+/// skipping (large ρ, K = 2) the cost has local minima the frequency estimate alone can fall into.
+/// Stage 2: derivative-free pattern search on the exact model (edge forces only where h > 0, as
+/// the simulation) from the stage-1 solution. With straight flutes the exact model's residuals
+/// jump by K_e·a_p where a tooth's chip crosses 0 and LM stalls there (round trip K = 6,
+/// ρ = 28 µm: 3 µm off; K = 3, ρ = 3 µm: 0.16 µm off).
+fn local_fit<'a>(
+    mut problem: Problem<'a>,
+    candidates: Vec<[f64; 2]>,
+) -> Result<(Problem<'a>, levenberg_marquardt::MinimizationReport<f64>), IdentifyError> {
     problem.set_smooth(true);
     let mut scored: Vec<(f64, DVector<f64>)> = Vec::with_capacity(candidates.len());
     for e in candidates {
@@ -705,11 +766,17 @@ pub fn full_signal_fit(
         r.number_of_evaluations += evals;
         (p, r)
     });
-    let (mut problem, report) =
-        best.ok_or_else(|| IdentifyError::singular("full-signal fit", "no valid start value"))?;
-    // Covariance from the analytic (smooth) runout derivatives: the differences also catch the
-    // edge-force steps, which carry no statistical information per sample and would inflate JᵀJ
-    // (standard errors 5× too small in the round-trip tests).
+    best.ok_or_else(|| IdentifyError::singular("full-signal fit", "no valid start value"))
+}
+
+/// Robust covariance at the solution, from the analytic (smooth) runout derivatives: the
+/// differences also catch the edge-force steps, which carry no statistical information per sample
+/// and would inflate JᵀJ (standard errors 5× too small in the round-trip tests). Each
+/// (recording, component) block is rotated to harmonics first.
+fn covariance_at_solution(
+    problem: &mut Problem<'_>,
+    cases: &[WaveformCase],
+) -> Result<FitCovariance, IdentifyError> {
     problem.analytic = true;
     problem.recompute();
     let jac = problem
@@ -718,15 +785,16 @@ pub fn full_signal_fit(
     let res = problem
         .residuals()
         .ok_or_else(|| IdentifyError::singular("full-signal fit", "non-finite residuals"))?;
-    let raw = problem.raw_residuals();
-    // Robust covariance: rotate each (recording, component) block to harmonics.
     let blocks: Vec<usize> = cases
         .iter()
         .flat_map(|c| std::iter::repeat_n(c.waveform.samples(), c.waveform.components.len()))
         .collect();
     let (jh, rh, groups) = time_blocks_to_harmonics(&jac, &res, &blocks);
-    let cov = fit_covariance(&jh, &rh, &groups);
-    // R² about each component's mean, unweighted.
+    Ok(fit_covariance(&jh, &rh, &groups))
+}
+
+/// Σ (v − v̄)² over every component about its own mean, unweighted (N²), for R².
+fn total_sum_of_squares(cases: &[WaveformCase]) -> f64 {
     let mut tss = 0.0;
     for case in cases {
         for comp in &case.waveform.components {
@@ -734,47 +802,25 @@ pub fn full_signal_fit(
             tss += comp.values.iter().map(|v| (v - m).powi(2)).sum::<f64>();
         }
     }
-    let rss: f64 = raw.iter().map(|r| r * r).sum();
-    let (e, tau) = problem.runout();
-    let mut coefficients = [0.0; 6];
-    let mut coefficient_se = [None; 6];
-    for (p, &i) in coef_idx.iter().enumerate() {
-        coefficients[i] = problem.x[nr + p];
-        coefficient_se[i] = Some(cov.se(nr + p));
-    }
-    let nd = problem.dirs.len();
-    let mut parameters: Vec<String> = if nd == 2 {
+    tss
+}
+
+/// Names of the fitted parameters: the runout ones (two components, or one along the tooth line
+/// when only that is observable), tilt, then the coefficients.
+fn parameter_names(runout_dirs: usize, fit_tilt: bool, coef_idx: &[usize]) -> Vec<String> {
+    let mut parameters: Vec<String> = if runout_dirs == 2 {
         vec!["ex_um".to_string(), "ey_um".to_string()]
     } else {
         vec!["e_along_tooth_line_um".to_string()]
     };
-    if options.fit_tilt {
+    if fit_tilt {
         parameters.extend([
             "tilt_x_um_per_mm".to_string(),
             "tilt_y_um_per_mm".to_string(),
         ]);
     }
     parameters.extend(coef_idx.iter().map(|&i| NAMES[i].to_string()));
-    Ok(fit_summary(FitSummaryInput {
-        e,
-        tau: options.fit_tilt.then_some(tau),
-        cov: &cov,
-        runout_dirs: &problem.dirs,
-        coefficients,
-        coefficient_se,
-        parameters,
-        rss,
-        tss,
-        n,
-        np,
-        evaluations: report.number_of_evaluations,
-        termination: format!("{:?}", report.termination),
-        converged: report.termination.was_successful(),
-        initial,
-        disks,
-        observability,
-        has_z: coef_idx.len() == 6,
-    }))
+    parameters
 }
 
 /// What [`fit_summary`] turns into a [`FullSignalFit`].

@@ -31,12 +31,12 @@ use super::full_signal::{
     candidate_runouts, compass_search, fit_summary, FitSummaryInput, FullSignalFit,
     FullSignalOptions, RunoutObservability, NAMES, RUNOUT_STEP_UM,
 };
-use super::lsq::linear_lsq;
 use super::model::{coefficient_gradient, BasisSums, RevolutionModel, NB};
 use super::sine_fit::Estimate;
-use super::waveform::{Axis, WaveformCase};
+use super::waveform::{FrameAxis, WaveformCase};
 use crate::chain::{AxisChain, Complex64, MeasuringChain, SensorMode};
 use crate::coefficients::CuttingCoefficients;
+use crate::fit::linear_lsq;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
 use realfft::RealFftPlanner;
@@ -60,7 +60,7 @@ pub enum ChainModel {
     /// jointly with runout and coefficients. `None` start values are found by a scan.
     FitModes {
         /// Axes with a mode and their start values (`None` = scan f_n, ζ 0.03, gain 1).
-        axes: Vec<(Axis, Option<SensorMode>)>,
+        axes: Vec<(FrameAxis, Option<SensorMode>)>,
         /// Also fit each mode's relative gain (default: a pure second-order mode, gain 1, whose
         /// peak height 1/2ζ is then carried by the damping alone).
         fit_gain: bool,
@@ -105,7 +105,7 @@ pub struct ChainFitReport {
 #[derive(Debug, Clone, Serialize)]
 pub struct FittedMode {
     /// Axis of the workpiece frame.
-    pub axis: Axis,
+    pub axis: FrameAxis,
     /// Natural frequency (Hz).
     pub frequency_hz: Estimate,
     /// Damping ratio.
@@ -139,7 +139,7 @@ struct HarmonicProblem<'a> {
     fit_tilt: bool,
     known: Option<MeasuringChain>,
     /// Fitted modes: axis per mode; parameters (ln f_n, ln ζ, g) in x (logs keep f_n, ζ > 0).
-    mode_axes: Vec<Axis>,
+    mode_axes: Vec<FrameAxis>,
     fit_gain: bool,
     /// Gains of the modes when not fitted (kept out of x).
     fixed_gain: Vec<f64>,
@@ -385,7 +385,7 @@ impl HarmonicProblem<'_> {
     }
     /// [`HarmonicProblem::fold`] of the six coefficient-gradient columns at once (the same sums
     /// in the same order: identical values, with H and the gradient evaluated once per m).
-    fn fold_gradient(&self, c: usize, axis: Axis, k: usize) -> [Complex64; 6] {
+    fn fold_gradient(&self, c: usize, axis: FrameAxis, k: usize) -> [Complex64; 6] {
         let d = &self.data[c];
         let top = self.oversample * d.n / 2;
         let mut sum = [Complex64::new(0.0, 0.0); 6];
@@ -411,7 +411,7 @@ impl HarmonicProblem<'_> {
     }
     /// H(m·f_rev)·e^{imδ} of case c, axis, true harmonic m (only e^{imδ} for the rigid
     /// comparison). A measured FRF is held at its last value above its range.
-    fn factor(&self, c: usize, axis: Axis, k: usize) -> Complex64 {
+    fn factor(&self, c: usize, axis: FrameAxis, k: usize) -> Complex64 {
         let d = &self.data[c];
         let mut h = Complex64::new(1.0, 0.0);
         if let Some(i) = d.free_angle {
@@ -432,7 +432,7 @@ impl HarmonicProblem<'_> {
         h
     }
     /// Rigid-model harmonic of the coefficient-gradient column i (K order) for axis.
-    fn gradient_harmonic(&self, c: usize, axis: Axis, k: usize) -> [Complex64; 6] {
+    fn gradient_harmonic(&self, c: usize, axis: FrameAxis, k: usize) -> [Complex64; 6] {
         let b = &self.basis[c];
         let mut re = [0.0; NB];
         let mut im = [0.0; NB];
@@ -445,12 +445,12 @@ impl HarmonicProblem<'_> {
         std::array::from_fn(|i| Complex64::new(gr[i], gi[i]))
     }
     /// Rigid-model harmonic m (true, oversampled) for axis.
-    fn model_harmonic(&self, c: usize, axis: Axis, m: usize, kc: &[f64; 6]) -> Complex64 {
+    fn model_harmonic(&self, c: usize, axis: FrameAxis, m: usize, kc: &[f64; 6]) -> Complex64 {
         let g = self.gradient_harmonic(c, axis, m);
         (0..6).map(|i| g[i] * kc[i]).sum()
     }
     /// Measured model harmonic k: chain and angle shift on the true harmonics, then sampling.
-    fn measured_model(&self, c: usize, axis: Axis, k: usize, kc: &[f64; 6]) -> Complex64 {
+    fn measured_model(&self, c: usize, axis: FrameAxis, k: usize, kc: &[f64; 6]) -> Complex64 {
         self.fold(c, k, |m| {
             self.factor(c, axis, m) * self.model_harmonic(c, axis, m, kc)
         })
@@ -653,7 +653,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for HarmonicProblem<'_> {
 }
 
 /// Highest harmonic of case c: below Nyquist, within a band limit and a measured FRF's range.
-fn max_harmonic(n: usize, spindle_hz: f64, model: &ChainModel, axes: &[Axis]) -> usize {
+fn max_harmonic(n: usize, spindle_hz: f64, model: &ChainModel, axes: &[FrameAxis]) -> usize {
     let mut kmax = (n - 1) / 2;
     match model {
         ChainModel::BandLimit { max_harmonic } => kmax = kmax.min(*max_harmonic),
@@ -685,7 +685,7 @@ fn case_data(
             spindle_hz,
         ));
     }
-    let axes: Vec<Axis> = case.waveform.components.iter().map(|k| k.axis).collect();
+    let axes: Vec<FrameAxis> = case.waveform.components.iter().map(|k| k.axis).collect();
     let kmax = max_harmonic(n, spindle_hz, &opts.model, &axes);
     let fft = planner.plan_fft_forward(n);
     let measured = case
@@ -873,7 +873,7 @@ pub(crate) fn harmonic_fit(
     }
     let has_z = cases
         .iter()
-        .any(|c| c.waveform.components.iter().any(|k| k.axis == Axis::Z));
+        .any(|c| c.waveform.components.iter().any(|k| k.axis == FrameAxis::Z));
     let coef_idx: Vec<usize> = if options.fixed_coefficients.is_some() {
         vec![]
     } else if has_z {
@@ -881,7 +881,7 @@ pub(crate) fn harmonic_fit(
     } else {
         vec![0, 1, 3, 4]
     };
-    type ModeStarts = Vec<(Axis, Option<SensorMode>)>;
+    type ModeStarts = Vec<(FrameAxis, Option<SensorMode>)>;
     let (known, mode_starts, fit_gain): (Option<MeasuringChain>, ModeStarts, bool) =
         match &chain.model {
             ChainModel::Known(c) => (Some(c.clone()), vec![], false),

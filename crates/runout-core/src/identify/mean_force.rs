@@ -27,11 +27,11 @@
 //! these values as start values and refine with [`super::full_signal_fit`], which models it.
 
 use super::error::IdentifyError;
-use super::lsq::{fit_line, Regression};
 use super::sine_fit::Estimate;
 use crate::coefficients::CuttingCoefficients;
 use crate::edge::EdgeTable;
 use crate::error::{finite, positive, ParamError};
+use crate::fit::{fit_line, Regression};
 use serde::Serialize;
 
 /// Mean forces (N, workpiece frame, averaged over whole revolutions) at one feed.

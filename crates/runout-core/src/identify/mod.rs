@@ -27,7 +27,7 @@
 //! let kc = CuttingCoefficients::new([1889.2, 806.1, 291.0], [63.12, 113.7, -3.1])?;
 //! let model = ForceModel { cutter: cutter.clone(), runout, cut, coefficients: kc };
 //! let s = model.simulate(&ArcChip::new(&cutter, &runout, 0.08)?, &Sampling::new(3.0, 1.0, 1)?);
-//! let w = AveragedWaveform::average(0.0, 360, &[(Axis::X, &s.fx), (Axis::Y, &s.fy)])?;
+//! let w = AveragedWaveform::average(0.0, 360, &[(FrameAxis::X, &s.fx), (FrameAxis::Y, &s.fy)])?;
 //! let fit = full_signal_fit(&[WaveformCase { cutter, cut, waveform: w }], &FullSignalOptions::default())?;
 //! assert!((fit.offset.value - 0.008).abs() < 1e-5 && (fit.angle.value - 0.5).abs() < 1e-3);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -39,15 +39,16 @@ mod error;
 mod frequency;
 mod full_signal;
 mod harmonic_fit;
-mod lsq;
 mod mean_force;
 mod model;
 mod multi_test;
 mod peak_coefficients;
+mod peak_test;
 mod pooled;
 mod sine_fit;
 mod waveform;
 
+pub use crate::fit::{fit_line, linear_lsq, r_squared, LinearFit, Regression};
 pub use alignment::{harmonic_start_angle, model_forces, refine_start_angle, residual_at};
 pub use error::IdentifyError;
 pub use frequency::{frequency_estimate, FrequencyEstimate};
@@ -55,7 +56,6 @@ pub use full_signal::{
     full_signal_fit, FullSignalFit, FullSignalOptions, RunoutObservability, SeParts,
 };
 pub use harmonic_fit::{ChainFitReport, ChainModel, ChainOptions, FittedMode};
-pub use lsq::{fit_line, linear_lsq, r_squared, LinearFit, Regression};
 pub use mean_force::{
     calibrate_mean_forces, calibrate_mean_forces_general, immersion_integrals,
     MeanForceCalibration, MeanForceDesign, MeanForces,
@@ -63,11 +63,14 @@ pub use mean_force::{
 pub use model::{
     coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel, NB, ND,
 };
-pub use multi_test::{analyse_tests, MultiTestResult, PeakTest, TestResult};
+pub use multi_test::{analyse_tests, MultiTestResult, TestResult};
 pub use peak_coefficients::{coefficients_at_peak, PeakCoefficients};
+pub use peak_test::PeakTest;
 pub use pooled::{pooled_fit, EdgeModel, PooledFit};
 pub use sine_fit::{
     peak_immersion, radius_difference, sine_fit, ErrorSource, Estimate, PeakConditions, SineFit,
     SineHypothesis, ToothPeaks,
 };
-pub use waveform::{AveragedWaveform, Axis, Component, WaveformCase};
+pub use waveform::{AveragedWaveform, FrameAxis, WaveformCase, WaveformComponent};
+#[doc(hidden)]
+pub use waveform::{Axis, Component};

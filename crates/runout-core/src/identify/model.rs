@@ -34,6 +34,11 @@
 //! [S₀, S₁, S₄, S₆, S₇, S₁₀, S₁₁, S₁₄] ([`ND`] = 8):
 //! ∂h/∂e = n_i − n_{i−m*}, n_i = (R(z) u_i + e(z))/R_i, m* the active term of the min;
 //! ∂h/∂τ = z·∂h/∂e. (The edge-force switch at h = 0 is not differentiated: measure zero.)
+//!
+//! One kernel (issue 13 item 6, issue 18): these sums are computed by the same function that
+//! serves [`crate::ForceModel::simulate`] (`force::kernel`: structure-of-arrays angle grid,
+//! engagement runs with lane masks, SIMD lanes selected at run time); the simulation multiplies
+//! them by the coefficients, the identification adds the derivatives.
 
 use super::waveform::Axis;
 use crate::angle::wrap_tau;
@@ -41,6 +46,7 @@ use crate::coefficients::CuttingCoefficients;
 use crate::cut::Cut;
 use crate::cutter::Cutter;
 use crate::edge::EdgeTable;
+use crate::force::kernel::{dispatch, padded, Acc, ArcGrad, ArcLanes, Grid, Options};
 use rayon::prelude::*;
 use std::f64::consts::TAU;
 
@@ -58,8 +64,8 @@ pub struct RevolutionModel {
     table: EdgeTable,
     /// f_{i,m} = f_z·K·gap(i, m)/2π, index i*K + m − 1.
     feed: Vec<f64>,
-    /// (θ, sin θ, cos θ) per grid sample.
-    grid: Vec<(f64, f64, f64)>,
+    /// θ, sin θ, cos θ per grid sample (structure of arrays, the kernel's layout).
+    grid: Grid,
     /// Apply the edge forces over the whole engagement window instead of only where h > 0
     /// (default false = as the simulation). The window-gated variant is continuous in the
     /// runout; the full-signal fit uses it for its first stage (see `full_signal`).
@@ -89,13 +95,11 @@ impl RevolutionModel {
                 feed.push(cut.fz() * k as f64 * cutter.gap(i, m) / TAU);
             }
         }
-        let grid = (0..samples)
-            .map(|q| {
-                let t = start_angle + TAU * q as f64 / samples as f64;
-                let (s, c) = t.sin_cos();
-                (t, s, c)
-            })
-            .collect();
+        let grid = Grid::new(
+            (0..samples).map(|q| start_angle + TAU * q as f64 / samples as f64),
+            TAU / samples.max(1) as f64,
+            true,
+        );
         RevolutionModel {
             k,
             disks,
@@ -108,7 +112,7 @@ impl RevolutionModel {
 
     /// Number of grid samples.
     pub fn samples(&self) -> usize {
-        self.grid.len()
+        self.grid.len
     }
 
     /// True when κ = 90° on every disk: basis rows 6–9 repeat rows 0–3 and rows 10–15 are zero.
@@ -155,9 +159,142 @@ impl RevolutionModel {
         }
     }
 
-    /// The kernel; `GENERAL = false` accumulates only the cylinder's rows 0–5 (derivative rows
-    /// 0–2), which is exact when κ = 90° on every disk.
+    /// The identification's own loop as it was before issue 18 (baseline of the benchmarks and
+    /// oracle of the equivalence tests): `general` forces the κ(z) kernel, `np` derivatives.
+    #[doc(hidden)]
+    pub fn sums_baseline(&self, e: [f64; 2], tau: [f64; 2], np: usize, general: bool) -> BasisSums {
+        let mut s = if general || !self.table.is_flat() {
+            self.compute_baseline::<true>(e, tau, np)
+        } else {
+            self.compute_baseline::<false>(e, tau, np)
+        };
+        if !general && self.table.is_flat() {
+            for b in &mut s.base {
+                b.copy_within(0..4, 6);
+            }
+            for d in s.deriv.iter_mut().flatten() {
+                d[3] = d[0];
+                d[4] = d[1];
+            }
+        }
+        s
+    }
+
+    /// The shared kernel ([`crate::force`]'s `kernel` module): the arc chip with exact radii
+    /// and the gradient of its active term, disks in parallel (rayon) and summed.
     fn compute_kernel<const GENERAL: bool>(
+        &self,
+        e: [f64; 2],
+        tau: [f64; 2],
+        np: usize,
+    ) -> BasisSums {
+        let k = self.k;
+        let kk = self.disks * k * k;
+        let mut lanes = ArcLanes {
+            k,
+            feed: Vec::with_capacity(kk),
+            dr: Vec::with_capacity(kk),
+            dnx: Vec::with_capacity(kk),
+            dny: Vec::with_capacity(kk),
+        };
+        for j in 0..self.disks {
+            let (dr, dn) = self.differences(j, e, tau);
+            lanes.feed.extend_from_slice(&self.feed);
+            lanes.dr.extend_from_slice(&dr);
+            lanes.dnx.extend(dn.iter().map(|d| d[0]));
+            lanes.dny.extend(dn.iter().map(|d| d[1]));
+        }
+        let lanes = ArcGrad(lanes);
+        let opts = Options {
+            edge_in_window: self.edge_in_window,
+            np,
+        };
+        let n = self.grid.len;
+        let stride = padded(n);
+        let arch = pulp::Arch::new();
+        let run = |mut acc: Acc, disks: std::ops::Range<usize>| {
+            dispatch::<ArcGrad, GENERAL, false>(
+                arch,
+                &self.table,
+                &lanes,
+                &self.grid,
+                disks,
+                opts,
+                None,
+                &mut acc,
+            );
+            acc
+        };
+        let empty = || Acc::new(stride, GENERAL, np, None);
+        let acc = if self.disks >= 8 {
+            (0..self.disks)
+                .into_par_iter()
+                .fold(empty, |acc, j| run(acc, j..j + 1))
+                .reduce(empty, |mut a, b| {
+                    a.add(&b);
+                    a
+                })
+        } else {
+            run(empty(), 0..self.disks)
+        };
+        let (rows, drows) = if GENERAL { (NB, ND) } else { (6, 3) };
+        let base = (0..n)
+            .map(|q| {
+                let mut b = [0.0f64; NB];
+                for (r, v) in b.iter_mut().enumerate().take(rows) {
+                    *v = acc.base[r * stride + q];
+                }
+                b
+            })
+            .collect();
+        let deriv = (0..n)
+            .map(|q| {
+                (0..np)
+                    .map(|p| {
+                        let mut d = [0.0f64; ND];
+                        for (r, v) in d.iter_mut().enumerate().take(drows) {
+                            *v = acc.deriv[(p * drows + r) * stride + q];
+                        }
+                        d
+                    })
+                    .collect()
+            })
+            .collect();
+        BasisSums { base, deriv }
+    }
+
+    /// Per (tooth, m) of disk j: R_i − R_{i−m} and n_i − n_{i−m} for runout e₀ + zτ.
+    fn differences(&self, j: usize, e: [f64; 2], tau: [f64; 2]) -> (Vec<f64>, Vec<[f64; 2]>) {
+        let k = self.k;
+        let disk = self.table.disk(j);
+        let z = disk.z;
+        let ez = [e[0] + z * tau[0], e[1] + z * tau[1]];
+        let r = disk.radius;
+        let pts: Vec<([f64; 2], f64)> = self
+            .table
+            .elements(j)
+            .iter()
+            .map(|sl| {
+                let p = [r * sl.cos_psi + ez[0], r * sl.sin_psi + ez[1]];
+                let ri = p[0].hypot(p[1]);
+                ([p[0] / ri, p[1] / ri], ri)
+            })
+            .collect();
+        let mut dr = vec![0.0; k * k];
+        let mut dn = vec![[0.0f64; 2]; k * k];
+        for i in 0..k {
+            for m in 1..=k {
+                let o = (i + k * m - m) % k;
+                dr[i * k + m - 1] = pts[i].1 - pts[o].1;
+                dn[i * k + m - 1] = [pts[i].0[0] - pts[o].0[0], pts[i].0[1] - pts[o].0[1]];
+            }
+        }
+        (dr, dn)
+    }
+
+    /// The loop before issue 18; `GENERAL = false` accumulates only the cylinder's rows 0–5
+    /// (derivative rows 0–2), which is exact when κ = 90° on every disk.
+    fn compute_baseline<const GENERAL: bool>(
         &self,
         e: [f64; 2],
         tau: [f64; 2],
@@ -194,9 +331,9 @@ impl RevolutionModel {
         // Each (disk, tooth) is in the engagement for one contiguous run of grid samples: visit
         // only that run (plus a guard sample each side) and apply the same exact test
         // `wrap(θ + ψ − φ_st) ≤ width` as the simulation. Disks in parallel (rayon), reduced.
-        let n = self.grid.len();
+        let n = self.grid.len;
         let dtheta = TAU / n as f64;
-        let theta0 = self.grid.first().map(|g| g.0).unwrap_or(0.0);
+        let theta0 = if n > 0 { self.grid.theta[0] } else { 0.0 };
         type Acc = (Vec<[f64; NB]>, Vec<[f64; ND]>);
         let empty = || (vec![[0.0f64; NB]; n], vec![[0.0f64; ND]; n * np]);
         let disk = |(mut b, mut d): Acc, j: usize| {
@@ -216,7 +353,8 @@ impl RevolutionModel {
                 let base_idx = (j * k + i) * k;
                 for t in 0..run {
                     let q = (first + t as i64).rem_euclid(n as i64) as usize;
-                    let (theta, st_t, ct_t) = self.grid[q];
+                    let (theta, st_t, ct_t) =
+                        (self.grid.theta[q], self.grid.sin[q], self.grid.cos[q]);
                     let rel = wrap_tau(theta + sl.psi - st);
                     if rel > width {
                         continue;

@@ -3,30 +3,12 @@
 //! vector mean of the runout, and the edge-force-aware pooled fit (§4.6) when ≥ 2 feeds are given.
 
 use super::error::IdentifyError;
-use super::lsq::{fit_line, Regression};
 use super::peak_coefficients::{coefficients_at_peak, PeakCoefficients};
+use super::peak_test::PeakTest;
 use super::pooled::{pooled_fit, EdgeModel, PooledFit};
-use super::sine_fit::{sine_fit, PeakConditions, SineFit, SineHypothesis, ToothPeaks};
+use super::sine_fit::{sine_fit, SineFit, SineHypothesis};
+use crate::fit::{fit_line, Regression};
 use serde::Serialize;
-
-/// One test: cut conditions, per-tooth peaks and optionally the nominal forces at the peak angle.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PeakTest {
-    /// Label (e.g. "1").
-    pub label: String,
-    /// Axial depth a_p (mm).
-    pub ap_mm: f64,
-    /// Feed and peak angle.
-    pub conditions: PeakConditions,
-    /// Peak immersion angle γ (rad) — for eq. (17).
-    pub peak_immersion_rad: f64,
-    /// Per-tooth peaks.
-    pub peaks: ToothPeaks,
-    /// Nominal F̄_x at the peak angle (N, workpiece frame), if measured.
-    pub fx_at_peak_n: Option<f64>,
-    /// Nominal F̄_y at the peak angle (N, workpiece frame), if measured.
-    pub fy_at_peak_n: Option<f64>,
-}
 
 /// Per-test result.
 #[derive(Debug, Clone, PartialEq, Serialize)]

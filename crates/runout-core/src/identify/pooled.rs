@@ -11,9 +11,9 @@
 //! Separating the edge terms from the shear term needs ≥ 2 distinct feeds.
 
 use super::error::IdentifyError;
-use super::lsq::{linear_lsq, r_squared};
-use super::multi_test::PeakTest;
+use super::peak_test::PeakTest;
 use super::sine_fit::Estimate;
+use crate::fit::{linear_lsq, r_squared};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -93,13 +93,6 @@ pub fn pooled_fit(tests: &[PeakTest], edge: EdgeModel) -> Result<PooledFit, Iden
     let n = y.len();
     let x = DMatrix::from_fn(n, p, |r, c| rows[r][c]);
     let fit = linear_lsq("pooled peak fit", &x, &DVector::from_column_slice(&y))?;
-    let cov = fit.covariance();
-    let se = |grad: &[f64]| {
-        cov.as_ref().map(|m| {
-            let g = DVector::from_column_slice(grad);
-            (g.transpose() * m * &g)[0].max(0.0).sqrt()
-        })
-    };
     let b = &fit.beta;
     let (kk, ku, kv) = (b[n_edge], b[n_edge + 1], b[n_edge + 2]);
     let rho = ku.hypot(kv) / kk;
@@ -115,21 +108,12 @@ pub fn pooled_fit(tests: &[PeakTest], edge: EdgeModel) -> Result<PooledFit, Iden
     let unit = |j: usize| {
         let mut g = vec![0.0; p];
         g[j] = 1.0;
-        Estimate {
-            value: b[j],
-            se: se(&g),
-        }
+        Estimate::delta_method(b[j], &fit, &g)
     };
     Ok(PooledFit {
         edge_model: edge,
-        offset: Estimate {
-            value: rho,
-            se: se(&g_rho),
-        },
-        angle: Estimate {
-            value: lambda,
-            se: se(&g_lam),
-        },
+        offset: Estimate::delta_method(rho, &fit, &g_rho),
+        angle: Estimate::delta_method(lambda, &fit, &g_lam),
         k_lumped: unit(n_edge),
         constant_n: (n_edge >= 1).then(|| unit(0)),
         edge_n_per_mm: (n_edge >= 2).then(|| unit(1)),

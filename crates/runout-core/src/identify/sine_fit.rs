@@ -25,10 +25,10 @@
 //! [`IdentifyError::DegenerateTwoTeeth`].
 
 use super::error::IdentifyError;
-use super::lsq::{linear_lsq, r_squared};
 use crate::cut::Cut;
 use crate::cutter::Cutter;
 use crate::error::{positive, ParamError};
+use crate::fit::{linear_lsq, r_squared};
 use crate::force::ToothPeak;
 use crate::runout::seed::lambda_from_seed003_phase;
 use nalgebra::{DMatrix, DVector, Matrix3};
@@ -184,20 +184,7 @@ pub enum SineHypothesis {
     ClosedPeriod,
 }
 
-/// A value with its standard error (`None` when it cannot be estimated).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Estimate {
-    /// The estimate.
-    pub value: f64,
-    /// Its standard error, if available.
-    pub se: Option<f64>,
-}
-
-impl Estimate {
-    fn new(value: f64, se: Option<f64>) -> Self {
-        Estimate { value, se }
-    }
-}
+pub use crate::estimate::Estimate;
 
 /// Where the standard errors of a sine fit come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]

@@ -11,10 +11,11 @@ use crate::error::ParamError;
 use serde::Serialize;
 use std::f64::consts::TAU;
 
-/// A force component of the workpiece frame.
+/// An axis of the workpiece frame (conventions.md: x = feed, y = feed-normal, z up): the
+/// direction of a force component, or the target of a channel in an axis mapping.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
-pub enum Axis {
+pub enum FrameAxis {
     /// Feed direction x.
     X,
     /// Feed-normal direction y.
@@ -23,11 +24,33 @@ pub enum Axis {
     Z,
 }
 
-/// One measured component over one revolution.
+impl FrameAxis {
+    /// All axes in order.
+    pub const ALL: [FrameAxis; 3] = [FrameAxis::X, FrameAxis::Y, FrameAxis::Z];
+
+    /// Position in [`FrameAxis::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// Lower-case letter `x`, `y` or `z`.
+    pub fn letter(self) -> char {
+        ['x', 'y', 'z'][self.index()]
+    }
+}
+
+/// Former name of [`FrameAxis`], kept until the callers outside this crate are renamed.
+#[doc(hidden)]
+pub use self::FrameAxis as Axis;
+/// Former name of [`WaveformComponent`], kept until the callers outside this crate are renamed.
+#[doc(hidden)]
+pub use self::WaveformComponent as Component;
+
+/// One measured force component over one revolution.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Component {
+pub struct WaveformComponent {
     /// Which force.
-    pub axis: Axis,
+    pub axis: FrameAxis,
     /// Averaged values (N), one per grid angle.
     pub values: Vec<f64>,
     /// Standard errors (N) per sample, if known.
@@ -40,7 +63,7 @@ pub struct AveragedWaveform {
     /// Spindle angle θ₀ (rad) of sample 0.
     pub start_angle: f64,
     /// Measured components (each of the same length N).
-    pub components: Vec<Component>,
+    pub components: Vec<WaveformComponent>,
     /// Number of revolutions averaged (for reports).
     pub revolutions: usize,
 }
@@ -100,16 +123,16 @@ impl AveragedWaveform {
     /// revolution-to-revolution standard deviation / √M (M ≥ 2).
     ///
     /// ```
-    /// use runout_core::identify::{AveragedWaveform, Axis};
+    /// use runout_core::identify::{AveragedWaveform, FrameAxis};
     /// let x: Vec<f64> = (0..40).map(|q| (q % 10) as f64 + if q < 10 { 0.1 } else { 0.0 }).collect();
-    /// let w = AveragedWaveform::average(0.0, 10, &[(Axis::X, &x)]).unwrap();
+    /// let w = AveragedWaveform::average(0.0, 10, &[(FrameAxis::X, &x)]).unwrap();
     /// assert_eq!(w.revolutions, 4);
     /// assert!((w.components[0].values[3] - 3.025).abs() < 1e-12);
     /// ```
     pub fn average(
         start_angle: f64,
         samples_per_rev: usize,
-        series: &[(Axis, &[f64])],
+        series: &[(FrameAxis, &[f64])],
     ) -> Result<Self, ParamError> {
         let len = series.first().map(|s| s.1.len()).unwrap_or(0);
         if samples_per_rev < 8 {
@@ -143,7 +166,7 @@ impl AveragedWaveform {
                         })
                         .collect()
                 });
-                Component {
+                WaveformComponent {
                     axis: *axis,
                     values: mean,
                     se,

@@ -12,6 +12,7 @@
 //! σ²(XᵀX)⁻¹ with σ² = RSS/(n − p); K_δ's error by linear propagation.
 
 use super::{ShankBeam, ShankError};
+use crate::fit::LinearLsq;
 use nalgebra::{DMatrix, DVector};
 
 /// One static load step.
@@ -97,18 +98,16 @@ pub fn calibrate(beam: &ShankBeam, steps: &[LoadStep]) -> Result<StaticCalibrati
     for (c, sc) in scale.iter().enumerate() {
         xs.column_mut(c).scale_mut(1.0 / sc);
     }
-    let svd = xs.clone().svd(true, true);
-    let smax = svd.singular_values.max();
-    let smin = svd.singular_values.min();
-    let condition_number = smax / smin;
+    let lsq = LinearLsq::new(xs);
+    let condition_number = lsq.condition();
     if !(condition_number.is_finite() && condition_number < 1e10) {
         return Err(bad(format!(
             "the load steps do not determine the unknowns (condition number {condition_number:.3e}); use ≥ 2 different forces{}",
             if two_points { " at each load point" } else { "" }
         )));
     }
-    let beta_s = svd
-        .solve(&y, 1e-14)
+    let beta_s = lsq
+        .beta(&y, 1e-14)
         .map_err(|e| bad(format!("least squares failed: {e}")))?;
     let beta: Vec<f64> = (0..p).map(|c| beta_s[c] / scale[c]).collect();
     let resid = &y - &x * DVector::from_vec(beta.clone());
@@ -117,8 +116,8 @@ pub fn calibrate(beam: &ShankBeam, steps: &[LoadStep]) -> Result<StaticCalibrati
     let tss = y.iter().map(|v| (v - mean).powi(2)).sum::<f64>();
     let dof = (n - p) as f64;
     let sigma2 = rss / dof;
-    let xtx_inv = (xs.transpose() * &xs)
-        .try_inverse()
+    let xtx_inv = lsq
+        .normal_inverse()
         .ok_or_else(|| bad("singular normal matrix".into()))?;
     let cov = |i: usize, j: usize| sigma2 * xtx_inv[(i, j)] / (scale[i] * scale[j]);
     let a_nom = beam.load_distance_mm();

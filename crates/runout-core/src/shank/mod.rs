@@ -38,9 +38,7 @@ pub use process::{
     Survey, SurveyResult,
 };
 pub use resonance::{ResonanceSpectrum, SpectralResonance};
-pub use spindle::{
-    frequency_from_air, peak_frequency, phasor, PhaseSegment, PulseDetector, SpindlePhase,
-};
+pub use spindle::{frequency_from_air, peak_frequency, phasor, PhaseSegment, SpindlePhase};
 pub use stiffness::{LoadPoint, ShankBeam};
 pub use synthetic::{SyntheticRecording, SyntheticShank};
 pub use template::{AngleTemplate, TemplateBuilder};

@@ -76,56 +76,6 @@ impl SpindlePhase {
     }
 }
 
-/// Rising-edge detector with hysteresis for a once-per-revolution pulse channel.
-#[derive(Debug, Clone)]
-pub struct PulseDetector {
-    high: f64,
-    low: f64,
-    armed: bool,
-    previous: Option<(f64, f64)>,
-    /// Edge times found, s.
-    pub edges_s: Vec<f64>,
-}
-
-impl PulseDetector {
-    /// Threshold halfway between `min` and `max` of the pulse signal, hysteresis ±10 % of the
-    /// swing. `None` if the signal does not swing.
-    pub fn new(min: f64, max: f64) -> Option<Self> {
-        let swing = max - min;
-        if !(swing.is_finite() && swing > 0.0) {
-            return None;
-        }
-        let mid = (min + max) / 2.0;
-        Some(Self {
-            high: mid + 0.1 * swing,
-            low: mid - 0.1 * swing,
-            armed: false,
-            previous: None,
-            edges_s: Vec::new(),
-        })
-    }
-
-    /// Feed one sample; an edge is the interpolated crossing of the mid level on the way up.
-    pub fn push(&mut self, t: f64, v: f64) {
-        if v <= self.low {
-            self.armed = true;
-        }
-        if self.armed && v >= self.high {
-            if let Some((tp, vp)) = self.previous {
-                let mid = (self.high + self.low) / 2.0;
-                let frac = if v > vp {
-                    ((mid - vp) / (v - vp)).clamp(0.0, 1.0)
-                } else {
-                    1.0
-                };
-                self.edges_s.push(tp + frac * (t - tp));
-            }
-            self.armed = false;
-        }
-        self.previous = Some((t, v));
-    }
-}
-
 /// Demeaned samples times a Hann window (suppresses leakage of the 2×, 3× … form harmonics and
 /// of the DC level into the 1× phasor; the window is symmetric, so the phase refers to the
 /// segment centre).
@@ -352,20 +302,20 @@ mod tests {
 
     #[test]
     fn pulse_edges_and_angle() {
-        let mut d = PulseDetector::new(0.0, 5.0).unwrap();
         let fs = 10_000.0;
-        for k in 0..10_000 {
-            let t = k as f64 / fs;
-            let v = if (t * 25.0).fract() < 0.1 { 5.0 } else { 0.0 };
-            d.push(t, v);
-        }
-        assert_eq!(d.edges_s.len(), 24);
+        let edges_s = crate::signal::PulseEdgeDetector::mid_with_hysteresis(0.0, 5.0)
+            .unwrap()
+            .edges((0..10_000).map(|k| {
+                let t = k as f64 / fs;
+                (t, if (t * 25.0).fract() < 0.1 { 5.0 } else { 0.0 })
+            }));
+        assert_eq!(edges_s.len(), 24);
         let p = SpindlePhase::Pulses {
-            edges_s: d.edges_s.clone(),
+            edges_s: edges_s.clone(),
         };
         assert!((p.mean_frequency_hz() - 25.0).abs() < 1e-9);
         let mut h = 0;
-        let a = p.angle(d.edges_s[3] + 0.02, &mut h);
+        let a = p.angle(edges_s[3] + 0.02, &mut h);
         assert!((a - TAU * 3.5).abs() < 1e-2, "{a}");
     }
 }

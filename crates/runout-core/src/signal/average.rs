@@ -28,11 +28,11 @@
 //! Memory: one revolution of samples (3 channels) + 4·M running statistics + K per-tooth.
 
 use super::chunk::ChunkGuard;
-use super::pulse::EdgeDetector;
+use super::pulse::PulseEdgeDetector;
 use super::scan::ScanResult;
 use super::stats::{parabolic_peak, BinStats, RunningStats};
 use super::tracker::SpindleSpeed;
-use super::{Chunk, Component, SignalConfig, SignalError};
+use super::{ForceComponent, SignalChunk, SignalConfig, SignalError};
 use crate::angle::wrap_tau;
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
@@ -68,7 +68,7 @@ pub enum ToothReference {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ComponentAverage {
     /// Which component.
-    pub component: Component,
+    pub component: ForceComponent,
     /// Mean per bin (N).
     #[serde(rename = "mean_N")]
     pub mean: Vec<f64>,
@@ -129,10 +129,10 @@ pub struct SyncAverage {
     /// Static offset (F_x, F_y, F_z) subtracted from every sample before averaging (N), if any.
     #[serde(rename = "offset_subtracted_N")]
     pub offset_subtracted: Option<[f64; 3]>,
-    /// Averages of F_x, F_y, F_z, |F_xy| in [`Component::ALL`] order.
+    /// Averages of F_x, F_y, F_z, |F_xy| in [`ForceComponent::ALL`] order.
     pub components: Vec<ComponentAverage>,
-    /// Component whose per-tooth peaks are given.
-    pub peak_component: Component,
+    /// Force component whose per-tooth peaks are given.
+    pub peak_component: ForceComponent,
     /// Which tooth is tooth 0.
     pub tooth_reference: ToothReference,
     /// Per-tooth peaks, tooth 0 first.
@@ -145,7 +145,7 @@ impl SyncAverage {
         self.angle_origin + TAU * j as f64 / self.bins as f64
     }
     /// Average of one component.
-    pub fn component(&self, c: Component) -> &ComponentAverage {
+    pub fn component(&self, c: ForceComponent) -> &ComponentAverage {
         &self.components[c.index()]
     }
 }
@@ -159,7 +159,7 @@ enum Marks {
         wander: Vec<(f64, f64)>,
     },
     Pulse {
-        det: EdgeDetector,
+        det: PulseEdgeDetector,
         to: f64,
     },
 }
@@ -171,7 +171,7 @@ pub struct SyncAverager {
     m: usize,
     k: usize,
     per_rev: usize,
-    component: Component,
+    component: ForceComponent,
     origin: f64,
     angle_reference: AngleReference,
     absolute_start: Option<f64>,
@@ -206,7 +206,7 @@ impl SyncAverager {
         let (marks, per_rev, origin, angle_reference) = match (cfg.pulse, scan.pulse_thresholds) {
             (Some(p), Some((lo, hi))) => (
                 Marks::Pulse {
-                    det: EdgeDetector::new(lo, hi),
+                    det: PulseEdgeDetector::new(lo, hi),
                     to,
                 },
                 p.pulses_per_rev,
@@ -271,7 +271,7 @@ impl SyncAverager {
     }
 
     /// Feed the next chunk.
-    pub fn push(&mut self, c: Chunk) -> Result<(), SignalError> {
+    pub fn push(&mut self, c: SignalChunk) -> Result<(), SignalError> {
         let start = self.guard.next;
         self.guard
             .check(&c, self.fs, matches!(self.marks, Marks::Pulse { .. }))?;
@@ -338,7 +338,7 @@ impl SyncAverager {
 
     /// Append samples `i0..i1` of `c` (global index `start + i`) to the buffer, offset removed.
     /// Outside a revolution only the last two samples are kept.
-    fn append(&mut self, c: &Chunk, i0: usize, i1: usize, start: u64) {
+    fn append(&mut self, c: &SignalChunk, i0: usize, i1: usize, start: u64) {
         let mut i0 = i0;
         if self.edges.is_empty() {
             i0 = i0.max(i1.saturating_sub(2));
@@ -401,7 +401,7 @@ impl SyncAverager {
                 sx[j] = f0;
                 sy[j] = f1;
                 sz[j] = a[2] + w * (b[2] - a[2]);
-                sxy[j] = Component::Fxy.of([f0, f1, 0.0]);
+                sxy[j] = ForceComponent::Fxy.of([f0, f1, 0.0]);
             }
         }
         self.acc.push(&self.scratch);
@@ -432,7 +432,7 @@ impl SyncAverager {
             });
         }
         let m = self.m;
-        let components: Vec<ComponentAverage> = Component::ALL
+        let components: Vec<ComponentAverage> = ForceComponent::ALL
             .iter()
             .map(|&c| {
                 let bins = c.index() * m..(c.index() + 1) * m;
@@ -507,12 +507,10 @@ fn mark_time(t_ref: f64, period: f64, r: u64, wander: &[(f64, f64)]) -> f64 {
 /// first boundary at or after `origin`.
 fn harmonic_boundary(wave: &[f64], k: usize, origin: f64) -> f64 {
     let m = wave.len();
-    let (mut re, mut im) = (0.0, 0.0);
-    for (j, &x) in wave.iter().enumerate() {
-        let a = k as f64 * TAU * j as f64 / m as f64;
-        re += x * a.cos();
-        im -= x * a.sin();
-    }
+    let (re, im) = crate::fit::fourier_coefficient(
+        wave.iter().copied(),
+        (0..m).map(|j| k as f64 * TAU * j as f64 / m as f64),
+    );
     // wave ≈ A·cos(K(θ−θ_origin) − ψ) with ψ = −arg X: maximum at θ_origin + ψ/K
     let psi = -im.atan2(re);
     let pitch = TAU / k as f64;

@@ -7,7 +7,7 @@ use super::SignalError;
 /// All present slices must have the same length. A channel absent in the first chunk must stay
 /// absent (F_z absent is averaged as 0 and reported as absent).
 #[derive(Debug, Clone, Copy, Default)]
-pub struct Chunk<'a> {
+pub struct SignalChunk<'a> {
     /// F_x (N).
     pub fx: &'a [f64],
     /// F_y (N).
@@ -18,10 +18,10 @@ pub struct Chunk<'a> {
     pub pulse: Option<&'a [f64]>,
 }
 
-impl<'a> Chunk<'a> {
+impl<'a> SignalChunk<'a> {
     /// F_x, F_y and F_z.
     pub fn xyz(fx: &'a [f64], fy: &'a [f64], fz: &'a [f64]) -> Self {
-        Chunk {
+        SignalChunk {
             fx,
             fy,
             fz: Some(fz),
@@ -42,8 +42,8 @@ impl<'a> Chunk<'a> {
         self.fx.is_empty()
     }
     /// Samples `a..b` of every channel.
-    pub fn slice(&self, a: usize, b: usize) -> Chunk<'a> {
-        Chunk {
+    pub fn slice(&self, a: usize, b: usize) -> SignalChunk<'a> {
+        SignalChunk {
             fx: &self.fx[a..b],
             fy: &self.fy[a..b],
             fz: self.fz.map(|v| &v[a..b]),
@@ -67,7 +67,7 @@ pub(crate) struct ChunkGuard {
 
 impl ChunkGuard {
     /// Validate `c` (whose first sample is `self.next`) and advance.
-    pub fn check(&mut self, c: &Chunk, fs: f64, want_pulse: bool) -> Result<(), SignalError> {
+    pub fn check(&mut self, c: &SignalChunk, fs: f64, want_pulse: bool) -> Result<(), SignalError> {
         let n = c.fx.len();
         let start = self.next;
         let bad = |what: String| SignalError::Channels {

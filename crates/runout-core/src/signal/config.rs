@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 /// A force component (or the resultant |F_xy|) on the workpiece (`conventions.md`, "Frames").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
-pub enum Component {
+pub enum ForceComponent {
     /// F_x (feed direction).
     Fx,
     /// F_y (feed-normal direction).
@@ -18,17 +18,22 @@ pub enum Component {
     Fxy,
 }
 
-impl Component {
+impl ForceComponent {
     /// All four, in the order of [`super::SyncAverage::components`].
-    pub const ALL: [Component; 4] = [Component::Fx, Component::Fy, Component::Fz, Component::Fxy];
+    pub const ALL: [ForceComponent; 4] = [
+        ForceComponent::Fx,
+        ForceComponent::Fy,
+        ForceComponent::Fz,
+        ForceComponent::Fxy,
+    ];
 
-    /// Index into [`Component::ALL`].
+    /// Index into [`ForceComponent::ALL`].
     pub fn index(self) -> usize {
         match self {
-            Component::Fx => 0,
-            Component::Fy => 1,
-            Component::Fz => 2,
-            Component::Fxy => 3,
+            ForceComponent::Fx => 0,
+            ForceComponent::Fy => 1,
+            ForceComponent::Fz => 2,
+            ForceComponent::Fxy => 3,
         }
     }
 
@@ -41,23 +46,23 @@ impl Component {
     #[inline]
     pub fn of(self, f: [f64; 3]) -> f64 {
         match self {
-            Component::Fx => f[0],
-            Component::Fy => f[1],
-            Component::Fz => f[2],
+            ForceComponent::Fx => f[0],
+            ForceComponent::Fy => f[1],
+            ForceComponent::Fz => f[2],
             // forces are far from overflow: the plain root is exact enough and 5× faster than hypot
-            Component::Fxy => (f[0] * f[0] + f[1] * f[1]).sqrt(),
+            ForceComponent::Fxy => (f[0] * f[0] + f[1] * f[1]).sqrt(),
         }
     }
 }
 
-impl std::str::FromStr for Component {
+impl std::str::FromStr for ForceComponent {
     type Err = ParamError;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s.trim().to_ascii_lowercase().as_str() {
-            "fx" => Ok(Component::Fx),
-            "fy" => Ok(Component::Fy),
-            "fz" => Ok(Component::Fz),
-            "fxy" | "|fxy|" => Ok(Component::Fxy),
+            "fx" => Ok(ForceComponent::Fx),
+            "fy" => Ok(ForceComponent::Fy),
+            "fz" => Ok(ForceComponent::Fz),
+            "fxy" | "|fxy|" => Ok(ForceComponent::Fxy),
             _ => Err(ParamError::new(
                 "peak_component",
                 "one of fx, fy, fz, fxy",
@@ -110,8 +115,8 @@ pub struct SignalConfig {
     /// Bins per revolution of the synchronous average; `None`: ≈ samples per revolution,
     /// clamped to [64, 4096].
     pub bins_per_rev: Option<usize>,
-    /// Component whose per-tooth peaks are reported (default |F_xy|).
-    pub peak_component: Component,
+    /// Force component whose per-tooth peaks are reported (default |F_xy|).
+    pub peak_component: ForceComponent,
     /// Section (from_s, to_s) to use instead of the automatic steady-cut detection.
     pub section_s: Option<(f64, f64)>,
     /// Pulse / encoder channel description, when the chunks carry one.
@@ -134,7 +139,7 @@ impl SignalConfig {
             nominal_rpm,
             search_band: 0.10,
             bins_per_rev: None,
-            peak_component: Component::Fxy,
+            peak_component: ForceComponent::Fxy,
             section_s: None,
             pulse: None,
             entry_angle_rad: None,

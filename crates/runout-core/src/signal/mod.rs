@@ -7,7 +7,7 @@
 //! absolute. Angles in radians, times in s, forces in N.
 //!
 //! # Streaming in bounded memory: three passes of accumulators
-//! A recording of hours at 50 kHz is fed chunk by chunk ([`Chunk`]: `&[f64]` per channel), three
+//! A recording of hours at 50 kHz is fed chunk by chunk ([`SignalChunk`]: `&[f64]` per channel), three
 //! times:
 //! 1. [`SpindleScan`] — Welch spectrum of F_x, F_y → coarse tooth-passing line and the consistency
 //!    check against K and rpm; per-revolution envelope → steady section; pulse-channel range.
@@ -24,7 +24,7 @@
 //! over a replayable source; [`analyse`] over samples in memory.
 //!
 //! ```
-//! use runout_core::signal::{analyse, Chunk, SignalConfig};
+//! use runout_core::signal::{analyse, SignalChunk, SignalConfig};
 //! // 3 teeth at 6000 rpm, 20 kHz: a pulse per tooth, one tooth 10 % stronger
 //! let fs = 20_000.0;
 //! let f = 6000.0 / 60.0;
@@ -37,7 +37,7 @@
 //!     fy.push(0.3 * pulse);
 //! }
 //! let cfg = SignalConfig::new(fs, 3, 6000.0)?;
-//! let a = analyse(&cfg, Chunk { fx: &fx, fy: &fy, fz: None, pulse: None })?;
+//! let a = analyse(&cfg, SignalChunk { fx: &fx, fy: &fy, fz: None, pulse: None })?;
 //! assert!((a.speed.rpm - 6000.0).abs() < 1.0);
 //! let peaks: Vec<f64> = a.average.tooth_peaks.iter().map(|p| p.peak).collect();
 //! let (hi, lo) = (peaks.iter().cloned().fold(0.0, f64::max), peaks.iter().cloned().fold(1e9, f64::min));
@@ -59,9 +59,16 @@ mod tracker;
 pub use average::{
     AngleReference, ComponentAverage, SyncAverage, SyncAverager, ToothPeakEstimate, ToothReference,
 };
-pub use chunk::Chunk;
-pub use config::{Component, PulseConfig, SignalConfig};
+pub use chunk::SignalChunk;
+/// Former name of [`SignalChunk`], kept until the callers outside this crate are renamed.
+#[doc(hidden)]
+pub use chunk::SignalChunk as Chunk;
+/// Former name of [`ForceComponent`], kept until the callers outside this crate are renamed.
+#[doc(hidden)]
+pub use config::ForceComponent as Component;
+pub use config::{ForceComponent, PulseConfig, SignalConfig};
 pub use error::SignalError;
+pub use pulse::PulseEdgeDetector;
 pub use scan::{ScanResult, SpindleScan};
 pub use spectrum::ToothPassingLine;
 pub use stats::RunningStats;
@@ -83,7 +90,7 @@ pub struct SignalAnalysis {
 }
 
 /// A sink the replay callback feeds chunks into.
-pub type ChunkSink<'s> = dyn FnMut(Chunk<'_>) -> Result<(), SignalError> + 's;
+pub type ChunkSink<'s> = dyn FnMut(SignalChunk<'_>) -> Result<(), SignalError> + 's;
 
 /// Run the three passes over a source that can be replayed: `replay(sink)` must feed the whole
 /// recording, in order, chunk by chunk, into `sink` (e.g. by re-reading a file). It is called
@@ -142,7 +149,7 @@ where
 }
 
 /// Run the pipeline over a recording held in memory (one chunk of all samples).
-pub fn analyse(cfg: &SignalConfig, rec: Chunk<'_>) -> Result<SignalAnalysis, SignalError> {
+pub fn analyse(cfg: &SignalConfig, rec: SignalChunk<'_>) -> Result<SignalAnalysis, SignalError> {
     analyse_replay(cfg, |sink: &mut ChunkSink<'_>| sink(rec))
 }
 
@@ -150,7 +157,7 @@ pub fn analyse(cfg: &SignalConfig, rec: Chunk<'_>) -> Result<SignalAnalysis, Sig
 /// the streaming path and for benchmarks).
 pub fn analyse_chunked(
     cfg: &SignalConfig,
-    rec: Chunk<'_>,
+    rec: SignalChunk<'_>,
     chunk: usize,
 ) -> Result<SignalAnalysis, SignalError> {
     let step = chunk.max(1);

@@ -4,7 +4,7 @@ use super::chunk::ChunkGuard;
 use super::pulse::Range;
 use super::spectrum::{ToothPassingLine, Welch};
 use super::steady::{Envelope, SteadySection};
-use super::{Chunk, SignalConfig, SignalError};
+use super::{SignalChunk, SignalConfig, SignalError};
 
 /// Pass-1 accumulator: feed every chunk of the recording, then [`SpindleScan::finish`].
 ///
@@ -53,7 +53,7 @@ impl SpindleScan {
     }
 
     /// Feed the next chunk.
-    pub fn push(&mut self, c: Chunk) -> Result<(), SignalError> {
+    pub fn push(&mut self, c: SignalChunk) -> Result<(), SignalError> {
         self.guard
             .check(&c, self.cfg.sample_rate_hz, self.cfg.pulse.is_some())?;
         for i in 0..c.len() {

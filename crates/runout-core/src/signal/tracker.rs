@@ -25,10 +25,10 @@
 //! Memory: O(1) (regression sums; for an encoder the last N edge times).
 
 use super::chunk::ChunkGuard;
-use super::pulse::EdgeDetector;
+use super::pulse::PulseEdgeDetector;
 use super::scan::ScanResult;
 use super::stats::RunningStats;
-use super::{Chunk, Component, SignalConfig, SignalError};
+use super::{ForceComponent, SignalChunk, SignalConfig, SignalError};
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::f64::consts::TAU;
@@ -154,7 +154,7 @@ enum Mode {
         knots: Knots,
     },
     Pulse {
-        det: EdgeDetector,
+        det: PulseEdgeDetector,
         per_rev: usize,
         edges: u64,
         recent: VecDeque<f64>,
@@ -172,7 +172,7 @@ pub struct PhaseTracker {
     to: f64,
     coarse_hz: f64,
     resolution_hz: f64,
-    component: Component,
+    component: ForceComponent,
     mode: Mode,
 }
 
@@ -184,7 +184,7 @@ impl PhaseTracker {
         let coarse = scan.coarse_spindle_hz;
         let mode = match (cfg.pulse, scan.pulse_thresholds) {
             (Some(p), Some((lo, hi))) => Mode::Pulse {
-                det: EdgeDetector::new(lo, hi),
+                det: PulseEdgeDetector::new(lo, hi),
                 per_rev: p.pulses_per_rev,
                 edges: 0,
                 recent: VecDeque::with_capacity(p.pulses_per_rev + 1),
@@ -224,7 +224,7 @@ impl PhaseTracker {
     }
 
     /// Feed the next chunk.
-    pub fn push(&mut self, c: Chunk) -> Result<(), SignalError> {
+    pub fn push(&mut self, c: SignalChunk) -> Result<(), SignalError> {
         let start = self.guard.next;
         let fs = self.cfg.sample_rate_hz;
         self.guard.check(&c, fs, self.cfg.pulse.is_some())?;

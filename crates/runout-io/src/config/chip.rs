@@ -240,7 +240,7 @@ pub fn read_cases(path: &Path) -> Result<Vec<ChipCase>, ChipConfigError> {
     let file = path.display().to_string();
     let text = crate::textfile::read_text(path).map_err(|e| ChipConfigError::Parse {
         file: file.clone(),
-        message: match e.line {
+        message: match e.line() {
             Some(l) => format!("line {l}: {}", e.message),
             None => e.message,
         },
@@ -281,8 +281,14 @@ fn cutter_of(s: &ChipCaseSpec) -> Result<Cutter, String> {
             vec![TAU / s.teeth as f64; s.teeth]
         }
     };
-    Cutter::new(s.diameter_mm, pitch, s.helix_deg, f64::INFINITY, profile)
-        .map_err(|e| e.to_string())
+    Cutter::new(
+        s.diameter_mm,
+        pitch,
+        s.helix_deg.to_radians(),
+        f64::INFINITY,
+        profile,
+    )
+    .map_err(|e| e.to_string())
 }
 
 fn runout_of(s: &ChipCaseSpec, cutter: &Cutter) -> Result<Runout, String> {

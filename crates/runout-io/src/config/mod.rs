@@ -184,6 +184,25 @@ impl Settings {
         }
     }
 
+    /// A word naming one variant of the serde enum `T` (`snake_case` names, e.g. `chip_model =
+    /// "exact"`), or `None` when unset; an unknown word is an error listing the accepted ones.
+    pub fn choice<T: serde::de::DeserializeOwned>(
+        &self,
+        key: &str,
+    ) -> Result<Option<T>, ConfigError> {
+        use serde::de::IntoDeserializer;
+        let Some(t) = self.text(key)? else {
+            return Ok(None);
+        };
+        let d: serde::de::value::StrDeserializer<'_, serde::de::value::Error> =
+            t.trim().into_deserializer();
+        T::deserialize(d).map(Some).map_err(|e| ConfigError::Key {
+            source_name: self.origin(key).unwrap_or("config").into(),
+            key: key.into(),
+            message: clip_quoted(&e.to_string()),
+        })
+    }
+
     /// A list of quantities: a TOML array or a comma-separated string (`"90,85,95,90"`).
     pub fn list(&self, key: &str, q: Quantity) -> Result<Option<Vec<f64>>, ConfigError> {
         match self.lookup(key) {

@@ -138,8 +138,30 @@ pub const SIMULATE_KEYS: &[(&str, Quantity, &str)] = &[
     ),
 ];
 
-/// Accepted values of `chip_model`: arc (eq. 0.4), exact (eq. 2.2–2.3), equivalent (eq. 2.8).
-pub const CHIP_MODELS: &[&str] = &["arc", "exact", "equivalent"];
+/// The chip-thickness model of a force simulation (`chip_model`): arc (methods.md eq. 0.4),
+/// exact (eq. 2.2–2.3), equivalent (eq. 2.8).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ForceChipModel {
+    /// Circular-arc approximation h = f_z sin φ with runout (eq. 0.4).
+    #[default]
+    Arc,
+    /// Exact trochoidal chip (Newton, eq. 2.2–2.3).
+    Exact,
+    /// Equivalent chip with compensation (eq. 2.8).
+    Equivalent,
+}
+
+impl ForceChipModel {
+    /// `arc`, `exact` or `equivalent`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ForceChipModel::Arc => "arc",
+            ForceChipModel::Exact => "exact",
+            ForceChipModel::Equivalent => "equivalent",
+        }
+    }
+}
 
 /// Names of all keys.
 pub fn simulate_key_names() -> Vec<&'static str> {
@@ -159,8 +181,8 @@ pub struct SimulateCase {
     pub coefficients: CuttingCoefficients,
     /// Sampling.
     pub sampling: Sampling,
-    /// Chip model name.
-    pub chip_model: String,
+    /// Chip-thickness model.
+    pub chip_model: ForceChipModel,
 }
 
 /// A model error for `e.param`, attributed to the layer that set that key.
@@ -186,25 +208,12 @@ pub fn resolve_cutter(s: &Settings) -> Result<Cutter, ConfigError> {
     let helix = s.or("helix_deg", Quantity::AngleDeg, 0.0)?;
     let flute = s.or("flute_length_mm", Quantity::LengthMm, f64::INFINITY)?;
     let profile = resolve_profile(s, d)?;
-    let lead = match s.text("flute_lead")?.as_deref().map(str::trim) {
-        None | Some("constant_lead") => FluteLead::ConstantLead,
-        Some("constant_helix") => FluteLead::ConstantHelix,
-        Some(o) => {
-            return Err(ConfigError::Key {
-                source_name: s.origin("flute_lead").unwrap_or("config").into(),
-                key: "flute_lead".into(),
-                message: format!(
-                    "expected constant_lead or constant_helix, got `{}`",
-                    super::clip_quoted(o)
-                ),
-            })
-        }
-    };
+    let lead: FluteLead = s.choice("flute_lead")?.unwrap_or_default();
     let cutter = match s.list("pitch_deg", Quantity::AngleDeg)? {
         None => Cutter::new(
             d,
             vec![std::f64::consts::TAU / teeth as f64; teeth],
-            helix,
+            helix.to_radians(),
             flute,
             profile.clone(),
         ),
@@ -222,7 +231,7 @@ pub fn resolve_cutter(s: &Settings) -> Result<Cutter, ConfigError> {
             Cutter::new(
                 d,
                 p.iter().map(|x| x.to_radians()).collect(),
-                helix,
+                helix.to_radians(),
                 flute,
                 profile,
             )
@@ -363,17 +372,7 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
             .map(|_| sm)
         })
         .map_err(|e| key_err(s, e))?;
-    let chip_model = s.text("chip_model")?.unwrap_or_else(|| "arc".into());
-    if !CHIP_MODELS.contains(&chip_model.as_str()) {
-        return Err(ConfigError::Key {
-            source_name: s.origin("chip_model").unwrap_or("config").into(),
-            key: "chip_model".into(),
-            message: format!(
-                "expected one of: {}; got `{chip_model}`",
-                CHIP_MODELS.join(", ")
-            ),
-        });
-    }
+    let chip_model: ForceChipModel = s.choice("chip_model")?.unwrap_or_default();
     let case = SimulateCase {
         cutter,
         runout,
@@ -394,7 +393,7 @@ impl SimulateCase {
     pub fn check_work(&self) -> Result<(), ConfigError> {
         let k = self.cutter.teeth() as f64;
         let n = self.sampling.revolutions * std::f64::consts::TAU / self.sampling.step;
-        let per = if self.chip_model == "exact" {
+        let per = if self.chip_model == ForceChipModel::Exact {
             k * k * k
         } else {
             k * k
@@ -414,5 +413,44 @@ impl SimulateCase {
         )
         .and_then(|_| limits::result_size("revolutions", n, 4.0 + k))
         .map_err(err)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::{Layer, Value};
+
+    fn settings(pairs: &[(&str, &str)]) -> Settings {
+        let mut s = Settings::new();
+        s.push(Layer {
+            origin: "case.toml".into(),
+            values: pairs
+                .iter()
+                .map(|(k, v)| (k.to_string(), Value::Text(v.to_string())))
+                .collect(),
+        });
+        s
+    }
+
+    #[test]
+    fn choices_are_serde_enums_and_unknown_words_name_the_key_and_the_choices() {
+        let s = settings(&[("chip_model", " exact "), ("flute_lead", "constant_helix")]);
+        assert_eq!(s.choice("chip_model").unwrap(), Some(ForceChipModel::Exact));
+        assert_eq!(
+            s.choice("flute_lead").unwrap(),
+            Some(FluteLead::ConstantHelix)
+        );
+        assert_eq!(s.choice::<ForceChipModel>("absent").unwrap(), None);
+        let e = settings(&[("chip_model", "trochoid")])
+            .choice::<ForceChipModel>("chip_model")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("case.toml: key `chip_model`")
+                && e.contains("`trochoid`")
+                && e.contains("`arc`, `exact`, `equivalent`"),
+            "{e}"
+        );
     }
 }

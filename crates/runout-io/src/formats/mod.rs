@@ -2,7 +2,7 @@
 //! `parquet` cargo feature, Parquet. Each format is read into a [`Catalog`] (every array the file
 //! holds: name, length, unit, rate) and a [`Source`] that delivers sample ranges of one array; a
 //! [`BinaryRecording`] then selects channels and the time base and yields the same
-//! [`RecordingInfo`] and [`Chunk`]s as the CSV/DynoWare reader, so every job reads every format
+//! [`RecordingInfo`] and [`RecordingChunk`]s as the CSV/DynoWare reader, so every job reads every format
 //! through [`open_recording`].
 //!
 //! Memory, per format:
@@ -28,7 +28,7 @@ pub use arrays::{recording_from_arrays, Arrays};
 pub use detect::{detect, detect_file, Kind};
 
 use crate::recording::{
-    Channel, Chunk, Format, ReadOptions, RecordingError, RecordingInfo, RecordingReader,
+    Channel, Format, ReadOptions, RecordingChunk, RecordingError, RecordingInfo, RecordingReader,
 };
 use serde::Serialize;
 use std::fs::File;
@@ -610,7 +610,7 @@ impl BinaryRecording {
     }
 
     /// Fill `chunk` with up to `max_rows` samples; 0 at the end.
-    pub fn read_chunk(&mut self, chunk: &mut Chunk, max_rows: usize) -> Result<usize> {
+    pub fn read_chunk(&mut self, chunk: &mut RecordingChunk, max_rows: usize) -> Result<usize> {
         chunk.first_sample = self.sample;
         chunk.time_s.clear();
         chunk.values.resize_with(self.columns.len(), Vec::new);
@@ -631,7 +631,7 @@ impl BinaryRecording {
         Ok(n)
     }
 
-    fn fill(&mut self, chunk: &mut Chunk, n: usize) -> Result<()> {
+    fn fill(&mut self, chunk: &mut RecordingChunk, n: usize) -> Result<()> {
         for (k, &e) in self.columns.iter().enumerate() {
             self.source.read(e, self.sample, n, &mut chunk.values[k])?;
             if chunk.values[k].len() != n {

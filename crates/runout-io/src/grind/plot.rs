@@ -1,7 +1,7 @@
 //! Plots of the grinding compensation: deviation heat map over (u, α), ε along the edge, and
 //! the predicted radial error before / after compensation (SVG or PNG by extension).
 
-use crate::plot::{colour, e2s, PlotError};
+use crate::plot::{colour, draw_legend, e2s, PlotError};
 use crate::render_plot;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -204,13 +204,7 @@ fn draw_lines<DB: DrawingBackend>(
         }
     }
     if legend {
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(e2s)?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     }
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! Chip-thickness plots: h vs spindle angle per tooth, and a map of h over path time × height
 //! (5-axis evaluation, methods.md §2).
 
-use super::{colour, e2s, PlotError};
+use super::{colour, draw_legend, e2s, legend_line, PlotError};
 use crate::render_plot;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -58,15 +58,9 @@ fn draw_angle<DB: DrawingBackend>(
             ))
             .map_err(e2s)?
             .label(format!("tooth {}", c.tooth))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2)));
+            .legend(legend_line(col.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(e2s)
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
 }
 
 /// A map of values over (x = path time, y = height): `values[ix][iy]` (µm) on the cell centred at

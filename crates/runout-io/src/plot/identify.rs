@@ -1,7 +1,7 @@
 //! Plots of a force-based runout identification: measured vs predicted waveforms, per-tooth peaks
 //! with the fitted sine, and the runout vector with its uncertainty in polar form.
 
-use super::{colour, e2s, PlotError};
+use super::{colour, draw_legend, e2s, legend_line, PlotError};
 use crate::render_plot;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -78,7 +78,7 @@ fn draw_overlay<DB: DrawingBackend>(
             ))
             .map_err(e2s)?
             .label(format!("{} measured", c.label))
-            .legend(move |(a, b)| PathElement::new(vec![(a, b), (a + 18, b)], col.stroke_width(2)));
+            .legend(legend_line(col.stroke_width(2)));
     }
     for (i, c) in predicted.iter().enumerate() {
         let col = predicted_colour(i);
@@ -91,15 +91,9 @@ fn draw_overlay<DB: DrawingBackend>(
             ))
             .map_err(e2s)?
             .label(format!("{} predicted", c.label))
-            .legend(move |(a, b)| PathElement::new(vec![(a, b), (a + 18, b)], col.stroke_width(2)));
+            .legend(legend_line(col.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(e2s)?;
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }
 
@@ -187,14 +181,8 @@ fn draw_bars<DB: DrawingBackend>(
             "fit C + A·sin(φ + 2πi/K): C {c:.1} N, A {a:.1} N, φ {:.1}°",
             phi.to_degrees()
         ))
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour(3).stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::LowerRight)
-        .draw()
-        .map_err(e2s)?;
+        .legend(legend_line(colour(3).stroke_width(2)));
+    draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
     Ok(())
 }
 
@@ -256,13 +244,7 @@ fn draw_polar<DB: DrawingBackend>(
         (r * a.sin(), r * a.cos())
     };
     // ring spacing: a round number giving 3–6 rings
-    let raw = rmax / 4.0;
-    let mag = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 2.5, 5.0, 10.0]
-        .iter()
-        .map(|f| f * mag)
-        .find(|s| *s >= raw)
-        .unwrap_or(10.0 * mag);
+    let step = crate::plot::polar_ring_step(rmax);
     let rings = (rmax / step).floor() as usize;
     for ring in 1..=rings {
         let r = step * ring as f64;
@@ -327,17 +309,11 @@ fn draw_polar<DB: DrawingBackend>(
                 "{}: ρ {:.2} µm at λ {:.1}°",
                 m.label, m.offset_um, m.angle_deg
             ))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(3)));
+            .legend(legend_line(col.stroke_width(3)));
         chart
             .draw_series(std::iter::once(Circle::new(tip, 4, col.filled())))
             .map_err(e2s)?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::LowerLeft)
-        .draw()
-        .map_err(e2s)?;
+    draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
     Ok(())
 }

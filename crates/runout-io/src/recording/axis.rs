@@ -2,32 +2,9 @@
 //! y = feed-normal, z up), with sign and swap, parsed from text such as
 //! `x = -Fy, y = -Fx, z = -Fz` and echoed back in the same form for results.
 
-use super::{Chunk, RecordingError, RecordingInfo};
+use super::{RecordingChunk, RecordingError, RecordingInfo};
+pub use runout_core::identify::FrameAxis;
 use std::fmt;
-
-/// A workpiece-frame axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Axis {
-    /// Feed direction.
-    X,
-    /// Feed-normal direction.
-    Y,
-    /// Up (tool axis).
-    Z,
-}
-
-impl Axis {
-    /// All axes in order.
-    pub const ALL: [Axis; 3] = [Axis::X, Axis::Y, Axis::Z];
-
-    fn index(self) -> usize {
-        self as usize
-    }
-
-    fn letter(self) -> char {
-        ['x', 'y', 'z'][self.index()]
-    }
-}
 
 /// Where one workpiece axis comes from: a channel and a sign.
 #[derive(Debug, Clone, PartialEq)]
@@ -75,9 +52,9 @@ impl AxisMapping {
                 ))
             })?;
             let axis = match lhs.trim().to_ascii_lowercase().as_str() {
-                "x" => Axis::X,
-                "y" => Axis::Y,
-                "z" => Axis::Z,
+                "x" => FrameAxis::X,
+                "y" => FrameAxis::Y,
+                "z" => FrameAxis::Z,
                 other => {
                     return Err(err(format!(
                         "`{other}` is not an axis (expected x, y or z)"
@@ -157,7 +134,7 @@ impl AxisMapping {
     }
 
     /// The source of one axis, if mapped.
-    pub fn source(&self, axis: Axis) -> Option<&AxisSource> {
+    pub fn source(&self, axis: FrameAxis) -> Option<&AxisSource> {
         self.axes[axis.index()].as_ref()
     }
 
@@ -189,7 +166,7 @@ impl AxisMapping {
 impl fmt::Display for AxisMapping {
     /// Canonical text, e.g. `x = -Fy, y = -Fx, z = -Fz` (parses back to the same mapping).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let parts: Vec<String> = Axis::ALL
+        let parts: Vec<String> = FrameAxis::ALL
             .iter()
             .filter_map(|&a| {
                 self.source(a).map(|s| {
@@ -214,13 +191,13 @@ pub struct ResolvedAxes {
 
 impl ResolvedAxes {
     /// Is this axis mapped?
-    pub fn has(&self, axis: Axis) -> bool {
+    pub fn has(&self, axis: FrameAxis) -> bool {
         self.sources[axis.index()].is_some()
     }
 
     /// Workpiece-frame values of `axis` for the whole chunk into `out` (cleared first);
     /// false if the axis is not mapped.
-    pub fn map_chunk(&self, chunk: &Chunk, axis: Axis, out: &mut Vec<f64>) -> bool {
+    pub fn map_chunk(&self, chunk: &RecordingChunk, axis: FrameAxis, out: &mut Vec<f64>) -> bool {
         out.clear();
         match self.sources[axis.index()] {
             Some((i, sign)) => {
@@ -232,7 +209,7 @@ impl ResolvedAxes {
     }
 
     /// One sample of `axis` from a row of channel values.
-    pub fn value(&self, axis: Axis, row: &[f64]) -> Option<f64> {
+    pub fn value(&self, axis: FrameAxis, row: &[f64]) -> Option<f64> {
         self.sources[axis.index()].map(|(i, s)| s * row[i])
     }
 }

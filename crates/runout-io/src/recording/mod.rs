@@ -3,12 +3,12 @@
 //! streaming CSV writer.
 //!
 //! ```
-//! use runout_io::recording::{ReadOptions, RecordingReader, Chunk};
+//! use runout_io::recording::{ReadOptions, RecordingReader, RecordingChunk};
 //! let text = "DynoWare,Version 2.5.1.2\nSampling rate [Hz]:,1000\nTime,Fx,Fy\ns,N,N\n\
 //!             0.000,1.5,2.5\n0.001,1.6,2.4\n";
 //! let mut r = RecordingReader::from_bytes("demo.txt", text.as_bytes(), &ReadOptions::new()).unwrap();
 //! assert_eq!(r.info().sample_rate_hz, 1000.0);
-//! let mut chunk = Chunk::default();
+//! let mut chunk = RecordingChunk::default();
 //! assert_eq!(r.read_chunk(&mut chunk, 1024).unwrap(), 2);
 //! assert_eq!(chunk.channel(1), &[2.5, 2.4]);
 //! ```
@@ -34,7 +34,11 @@ mod writer;
 
 pub use crate::formats::{open_recording, recording_from_bytes};
 pub use axis::AxisMappingError;
-pub use axis::{Axis, AxisMapping, AxisSource, ResolvedAxes};
+/// Former name of [`FrameAxis`] (now shared with `runout_core::identify`), kept until the callers
+/// outside this crate are renamed.
+#[doc(hidden)]
+pub use axis::FrameAxis as Axis;
+pub use axis::{AxisMapping, AxisSource, FrameAxis, ResolvedAxes};
 pub use error::RecordingError;
 pub use reader::{RecordingReader, DEFAULT_CHUNK_ROWS};
 pub use writer::{read_binary, BinaryLayout, BinaryWriter, CsvWriter, BINARY_MAGIC};
@@ -167,7 +171,7 @@ pub struct RecordingInfo {
     pub metadata: Vec<(String, String)>,
     /// Every column of the header.
     pub columns: Vec<Channel>,
-    /// The channels delivered, in the order of [`Chunk::values`].
+    /// The channels delivered, in the order of [`RecordingChunk::values`].
     pub channels: Vec<Channel>,
     /// The time column, if any.
     pub time_column: Option<Channel>,
@@ -211,9 +215,13 @@ impl RecordingInfo {
     }
 }
 
+/// Former name of [`RecordingChunk`], kept until the callers outside this crate are renamed.
+#[doc(hidden)]
+pub type Chunk = RecordingChunk;
+
 /// A block of consecutive samples: time and one vector per delivered channel.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct Chunk {
+pub struct RecordingChunk {
     /// Index of the first sample in the recording (0-based).
     pub first_sample: u64,
     /// Sample times, s (the time column, or t₀ + k/f_s).
@@ -222,7 +230,7 @@ pub struct Chunk {
     pub values: Vec<Vec<f64>>,
 }
 
-impl Chunk {
+impl RecordingChunk {
     /// Rows in the chunk.
     pub fn len(&self) -> usize {
         self.time_s.len()
@@ -268,11 +276,11 @@ impl Recording {
     }
 
     fn drain<R: std::io::BufRead>(mut r: RecordingReader<R>) -> Result<Self, RecordingError> {
-        let mut all = Chunk {
+        let mut all = RecordingChunk {
             values: vec![Vec::new(); r.info().channels.len()],
-            ..Chunk::default()
+            ..RecordingChunk::default()
         };
-        let mut c = Chunk::default();
+        let mut c = RecordingChunk::default();
         while r.read_chunk(&mut c, DEFAULT_CHUNK_ROWS)? > 0 {
             all.time_s.extend_from_slice(&c.time_s);
             for (a, v) in all.values.iter_mut().zip(&c.values) {

@@ -5,7 +5,7 @@ use super::header::{
     detect_decimal_comma, detect_delimiter, is_unit_row, key_line, meta_number, split_unit,
 };
 use super::text::{binary_issue, decode, fields, parse_number, trim_field};
-use super::{Channel, Chunk, Format, ReadOptions, RecordingInfo};
+use super::{Channel, Format, ReadOptions, RecordingChunk, RecordingInfo};
 use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
@@ -114,7 +114,7 @@ enum Slot {
 /// A streaming reader of one recording (generic CSV/TSV or Kistler DynoWare text export).
 ///
 /// Opening reads only the header and up to 1000 data rows (kept for the reader); then
-/// [`RecordingReader::read_chunk`] parses rows into a reusable [`Chunk`], so memory is bounded by
+/// [`RecordingReader::read_chunk`] parses rows into a reusable [`RecordingChunk`], so memory is bounded by
 /// the chunk size whatever the file length. After an error the reader is finished.
 pub struct RecordingReader<R> {
     lines: LineSource<R>,
@@ -446,7 +446,7 @@ impl<R: BufRead> RecordingReader<R> {
 
     /// Fill `chunk` (cleared first, capacity kept) with up to `max_rows` rows; returns the
     /// number of rows, 0 at the end of the data.
-    pub fn read_chunk(&mut self, chunk: &mut Chunk, max_rows: usize) -> Result<usize> {
+    pub fn read_chunk(&mut self, chunk: &mut RecordingChunk, max_rows: usize) -> Result<usize> {
         if let Some(b) = &mut self.binary {
             return b.read_chunk(chunk, max_rows);
         }
@@ -489,8 +489,8 @@ impl<R: BufRead> RecordingReader<R> {
     }
 
     /// Next chunk of the configured size (`ReadOptions::chunk_rows`), `None` at the end.
-    pub fn next_chunk(&mut self) -> Result<Option<Chunk>> {
-        let mut c = Chunk::default();
+    pub fn next_chunk(&mut self) -> Result<Option<RecordingChunk>> {
+        let mut c = RecordingChunk::default();
         let n = self.read_chunk(&mut c, self.chunk_rows)?;
         Ok((n > 0).then_some(c))
     }
@@ -508,7 +508,7 @@ impl<R: BufRead> RecordingReader<R> {
     }
 
     /// Parse one data row into `chunk` (hot loop).
-    fn parse_row(&mut self, line: u64, row: &[u8], chunk: &mut Chunk) -> Result<()> {
+    fn parse_row(&mut self, line: u64, row: &[u8], chunk: &mut RecordingChunk) -> Result<()> {
         let delim = self.info.delimiter as u8;
         let dc = self.info.decimal_comma;
         let mut n_fields = 0;
@@ -559,7 +559,12 @@ impl<R: BufRead> RecordingReader<R> {
     }
 
     /// Check the time cell (if any) and push the sample time.
-    fn check_time(&mut self, line: u64, time: Option<f64>, chunk: &mut Chunk) -> Result<()> {
+    fn check_time(
+        &mut self,
+        line: u64,
+        time: Option<f64>,
+        chunk: &mut RecordingChunk,
+    ) -> Result<()> {
         let fs = self.info.sample_rate_hz;
         let expected = self.info.start_time_s + self.sample as f64 / fs;
         let Some(t) = time else {

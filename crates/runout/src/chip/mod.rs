@@ -21,7 +21,7 @@ pub fn read_cases(config: &Source) -> Result<Vec<ChipCase>, ChipConfigError> {
     let file = config.name().to_string();
     let text = config.read_text().map_err(|e| ChipConfigError::Parse {
         file: file.clone(),
-        message: match e.line {
+        message: match e.line() {
             Some(l) => format!("line {l}: {}", e.message),
             None => e.message,
         },

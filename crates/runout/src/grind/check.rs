@@ -12,6 +12,13 @@ use runout_core::grind::*;
 use schemars::JsonSchema;
 use serde::Serialize;
 
+/// The axis offset x, y (µm, bar frame) of a runout of length `rho_um` (µm) in the direction
+/// `angle_deg` (deg, from x towards y): (ρ cos λ, ρ sin λ), methods.md §5.1.
+pub fn offset_xy_um(rho_um: f64, angle_deg: f64) -> [f64; 2] {
+    let (s, c) = angle_deg.to_radians().sin_cos();
+    [rho_um * c, rho_um * s]
+}
+
 /// `runout grind check`.
 #[derive(Debug, Clone)]
 pub struct CheckRequest {

@@ -5,7 +5,9 @@ mod check;
 mod compensate;
 pub mod render;
 
-pub use check::{check, CheckInputs, CheckReport, CheckRequest, SchemeCheck, Uncompensated};
+pub use check::{
+    check, offset_xy_um, CheckInputs, CheckReport, CheckRequest, SchemeCheck, Uncompensated,
+};
 pub use compensate::{
     compensate, AngleSense, AxisReport, CompensateDetail, CompensateReport, CompensateRequest,
     CompensationReport, GeneratrixFrom, GridReport, InputsReport, LayerReport, NcMapping, NcReport,

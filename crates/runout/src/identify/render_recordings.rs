@@ -142,7 +142,7 @@ fn recording_text(f: &RecordingReport) -> String {
 fn calibration_text(r: &RecordingsReport) -> String {
     match &r.mean_force_calibration {
         Calibration::Fitted(k) => {
-            let k: &MeanForceCalibration = k;
+            let k: &MeanForceCalibration = k.as_ref();
             format!(
                 "\nmean-force calibration: K_tc {:.1}, K_rc {:.1} N/mm², K_te {:.2}, K_re {:.2} N/mm{}\n",
                 k.ktc.value,

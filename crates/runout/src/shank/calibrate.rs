@@ -5,7 +5,7 @@ use super::config::{displacement_scale, load_config, open};
 use crate::job::{Report, Source};
 use anyhow::Result;
 use runout_core::shank::{LoadPoint, LoadStep};
-use runout_io::recording::{Chunk, ReadOptions};
+use runout_io::recording::{ReadOptions, RecordingChunk};
 use schemars::JsonSchema;
 use serde::Serialize;
 
@@ -88,7 +88,7 @@ pub fn calibrate(req: &CalibrateRequest) -> Result<CalibrationReport> {
     let s1 = displacement_scale(&info, 1, &r)?;
     let sign = r.setup.pairs[0].sign;
     let mut steps = Vec::new();
-    let mut chunk = Chunk::default();
+    let mut chunk = RecordingChunk::default();
     while reader.read_chunk(&mut chunk, 65_536)? > 0 {
         for k in 0..chunk.len() {
             steps.push(LoadStep {

@@ -351,9 +351,9 @@ pub(crate) fn plan(source: &Source, r: &Resolved) -> Result<(Plan, RecordingInfo
             let m = AxisMapping::parse(t)?;
             for p in &r.setup.pairs {
                 let axis = if p.axis == PairAxis::X {
-                    runout_io::recording::Axis::X
+                    runout_io::recording::FrameAxis::X
                 } else {
-                    runout_io::recording::Axis::Y
+                    runout_io::recording::FrameAxis::Y
                 };
                 let Some(src) = m.source(axis) else {
                     bail!(
@@ -392,9 +392,9 @@ pub(crate) fn plan(source: &Source, r: &Resolved) -> Result<(Plan, RecordingInfo
             let m = reference.as_ref().expect("reference mapping");
             let k = i - nd - usize::from(r.setup.has_pulse);
             let axis = if r.setup.pairs[k].axis == PairAxis::X {
-                runout_io::recording::Axis::X
+                runout_io::recording::FrameAxis::X
             } else {
-                runout_io::recording::Axis::Y
+                runout_io::recording::FrameAxis::Y
             };
             s * m.source(axis).map_or(1.0, |s| s.sign)
         });

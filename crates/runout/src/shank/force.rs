@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use runout_core::shank::{
     analyse, ComparisonMetrics, OutputBlock, PairAxis, Reconstructor, ShankAnalysis, Survey,
 };
-use runout_io::recording::{BinaryLayout, BinaryWriter, Chunk, CsvWriter, RecordingInfo};
+use runout_io::recording::{BinaryLayout, BinaryWriter, CsvWriter, RecordingChunk, RecordingInfo};
 use schemars::JsonSchema;
 use serde::Serialize;
 use std::io::Write;
@@ -372,7 +372,7 @@ pub fn force_to(
     // pass 1
     let mut survey = Survey::new(&r.setup)?;
     let mut reader = open(&req.recording, &r, &plan.names)?;
-    let mut chunk = Chunk::default();
+    let mut chunk = RecordingChunk::default();
     let mut raw = Thinned::new();
     let mut spill = if req.reparse {
         None
@@ -579,7 +579,7 @@ pub fn force_to(
     Ok(report)
 }
 
-fn scale_chunk(chunk: &mut Chunk, scales: &[f64]) {
+fn scale_chunk(chunk: &mut RecordingChunk, scales: &[f64]) {
     for (v, s) in chunk.values.iter_mut().zip(scales) {
         if *s != 1.0 {
             v.iter_mut().for_each(|x| *x *= s);

@@ -22,20 +22,32 @@ pub struct Args {
     pub out: OutputFlags,
 }
 
+/// `--method ols|eq6`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum MethodArg {
+    Ols,
+    Eq6,
+}
+
 pub fn run(a: Args) -> Result<()> {
     let at_mm = quantity("at-mm", &a.at_mm, Quantity::LengthMm)?.unwrap_or(0.0);
-    let method = match a.method.as_deref() {
-        None | Some("ols") => HeightRegression::Ols,
-        Some("eq6") => HeightRegression::SeedEq6,
-        Some(o) => bail!("--method: `{o}` is not `ols` or `eq6`"),
+    let method = match a
+        .method
+        .as_deref()
+        .map(|t| choice::<MethodArg>("--method", t))
+        .transpose()?
+    {
+        None | Some(MethodArg::Ols) => HeightRegression::Ols,
+        Some(MethodArg::Eq6) => HeightRegression::SeedEq6,
     };
-    a.out.check(&a.table)?;
+    let plot = a.out.check(&a.table, "heights")?;
     let report = heights(&HeightsRequest {
         table: Source::path(&a.table),
         at_mm,
         method,
     })?;
-    if let Some(p) = &a.out.plot {
+    if let Some(p) = &plot {
+        a.out.plots.create_dir()?;
         render::heights_plot(p, &report)?;
     }
     a.out.write(&report, &render::heights_text(&report))

@@ -7,6 +7,7 @@ mod heights;
 mod signal;
 mod teeth;
 
+use crate::flags::choice;
 use anyhow::{bail, Context, Result};
 use runout::displacement::Sensor;
 use runout_core::displacement::{BeamGeometry, SensorSign};
@@ -50,18 +51,17 @@ pub struct OutputFlags {
     /// Write the human-readable report here instead of stdout (`-` = stdout).
     #[arg(long, allow_hyphen_values = true)]
     pub text: Option<PathBuf>,
-    /// Plot (.svg or .png).
-    #[arg(long, allow_hyphen_values = true)]
-    pub plot: Option<PathBuf>,
+    /// Plot (`teeth`, `heights` or `signal`.<format>).
+    #[command(flatten)]
+    pub plots: crate::flags::PlotFlags,
 }
 
 impl OutputFlags {
-    /// Refuse outputs that overwrite `input`.
-    pub fn check(&self, input: &Path) -> Result<()> {
-        for out in [&self.json, &self.text, &self.plot].into_iter().flatten() {
-            crate::output::check_not_input(out, &[input])?;
-        }
-        Ok(())
+    /// Refuse outputs that overwrite `input`; the plot file of `kind`.
+    pub fn check(&self, input: &Path, kind: &str) -> Result<Option<PathBuf>> {
+        let plot = self.plots.file(kind);
+        crate::flags::check_outputs([&self.json, &self.text, &plot], &[input])?;
+        Ok(plot)
     }
 
     /// Write JSON and text (text to stdout unless the JSON goes there).
@@ -91,40 +91,35 @@ pub fn um_as_mm(flag: &str, v: &Option<String>) -> Result<Option<f64>> {
     Ok(quantity(flag, v, Quantity::LengthUm)?.map(|x| x * 1e-3))
 }
 
-/// A count flag (integer ≥ 1).
-pub fn count(flag: &str, v: &Option<String>) -> Result<Option<usize>> {
-    v.as_deref()
-        .map(|t| {
-            t.trim()
-                .parse::<usize>()
-                .ok()
-                .filter(|n| *n >= 1)
-                .with_context(|| format!("--{flag}: `{t}` is not an integer >= 1"))
-        })
-        .transpose()
-}
-
 /// `--sensor distance|radial`.
-pub fn sensor_sign(v: &Option<String>) -> Result<SensorSign> {
-    match v.as_deref().map(str::trim) {
-        None | Some("distance") => Ok(SensorSign::Distance),
-        Some("radial") => Ok(SensorSign::Radial),
-        Some(o) => bail!("--sensor: `{o}` is not `distance` (reading grows away from the tool) or `radial` (reading grows with the radius)"),
-    }
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum SignArg {
+    /// The reading grows away from the tool (triangulation lasers).
+    Distance,
+    /// The reading grows with the radius.
+    Radial,
 }
 
-/// Cutter flags shared by teeth and signal.
+/// `--sensor distance|radial` (default distance).
+pub fn sensor_sign(v: &Option<String>) -> Result<SensorSign> {
+    Ok(
+        match v
+            .as_deref()
+            .map(|t| choice::<SignArg>("--sensor", t))
+            .transpose()?
+        {
+            None | Some(SignArg::Distance) => SensorSign::Distance,
+            Some(SignArg::Radial) => SensorSign::Radial,
+        },
+    )
+}
+
+/// Cutter flags shared by teeth and signal: the cutter (the flags of every command) and where
+/// it is read.
 #[derive(clap::Args, Debug, Default)]
 pub struct CutterFlags {
-    /// Number of teeth K.
-    #[arg(long, allow_hyphen_values = true)]
-    pub teeth: Option<String>,
-    /// Nominal cutter diameter D (mm).
-    #[arg(long, allow_hyphen_values = true)]
-    pub diameter_mm: Option<String>,
-    /// Helix angle (deg), 0 for straight flutes.
-    #[arg(long, allow_hyphen_values = true)]
-    pub helix_deg: Option<String>,
+    #[command(flatten)]
+    pub cutter: crate::flags::CutterFlags,
     /// Height z of the readings above the tool tip (mm); tooth angles follow the helix.
     #[arg(long, allow_hyphen_values = true)]
     pub height_mm: Option<String>,
@@ -139,14 +134,7 @@ pub struct CutterFlags {
 impl CutterFlags {
     /// The cutter, when --teeth and --diameter-mm are given.
     pub fn cutter(&self) -> Result<Option<Cutter>> {
-        let k = count("teeth", &self.teeth)?;
-        let d = quantity("diameter-mm", &self.diameter_mm, Quantity::LengthMm)?;
-        let helix = quantity("helix-deg", &self.helix_deg, Quantity::AngleDeg)?.unwrap_or(0.0);
-        match (k, d) {
-            (Some(k), Some(d)) => Ok(Some(Cutter::flat(d, k, helix)?)),
-            (None, None) => Ok(None),
-            _ => bail!("--teeth and --diameter-mm go together"),
-        }
+        self.cutter.cutter()
     }
     /// Height (mm), default 0.
     pub fn height(&self) -> Result<f64> {

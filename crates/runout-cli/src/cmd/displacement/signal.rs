@@ -28,9 +28,10 @@ pub struct Args {
     /// Diameter of the measured round section (mm); needed with --inclination-deg/--beam-offset-mm.
     #[arg(long, allow_hyphen_values = true)]
     pub surface_diameter_mm: Option<String>,
-    /// Spindle angle of tooth 0 measured from the once-per-revolution mark (deg); λ is reported from tooth 0.
-    #[arg(long, allow_hyphen_values = true)]
-    pub tooth0_deg: Option<String>,
+    /// Spindle angle of tooth 0 measured from the once-per-revolution mark (deg); λ is reported
+    /// from tooth 0. Old spelling `--tooth0-deg` (hidden, one release).
+    #[arg(long, alias = "tooth0-deg", allow_hyphen_values = true)]
+    pub tooth0_angle_deg: Option<String>,
     /// Start of the section to analyse (s, on the file's time axis); default: the start. Samples
     /// outside the section are read and dropped, so long files need not fit in memory.
     #[arg(long, allow_hyphen_values = true)]
@@ -44,6 +45,15 @@ pub struct Args {
     pub beam: BeamFlags,
     #[command(flatten)]
     pub out: OutputFlags,
+}
+
+/// `--reference auto|pulse|encoder|none`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum ReferenceArg {
+    Auto,
+    Pulse,
+    Encoder,
+    None,
 }
 
 pub fn run(a: Args) -> Result<()> {
@@ -67,12 +77,16 @@ pub fn run(a: Args) -> Result<()> {
                 .context("--sensor-angles-deg")
         })
         .transpose()?;
-    let reference = match a.reference.as_deref().unwrap_or("auto") {
-        "auto" => ReferenceChoice::Auto,
-        "pulse" => ReferenceChoice::Pulse,
-        "encoder" => ReferenceChoice::Encoder,
-        "none" => ReferenceChoice::None,
-        o => bail!("--reference: `{o}` is not auto, pulse, encoder or none"),
+    let reference = match a
+        .reference
+        .as_deref()
+        .map(|t| choice::<ReferenceArg>("--reference", t))
+        .transpose()?
+    {
+        None | Some(ReferenceArg::Auto) => ReferenceChoice::Auto,
+        Some(ReferenceArg::Pulse) => ReferenceChoice::Pulse,
+        Some(ReferenceArg::Encoder) => ReferenceChoice::Encoder,
+        Some(ReferenceArg::None) => ReferenceChoice::None,
     };
     let (fz_mm, hole_path_mm) = a.cutter.fz_and_hole()?;
     let req = SignalRequest {
@@ -90,7 +104,7 @@ pub fn run(a: Args) -> Result<()> {
             &a.surface_diameter_mm,
             Quantity::LengthMm,
         )?,
-        tooth0_rad: quantity("tooth0-deg", &a.tooth0_deg, Quantity::AngleDeg)?
+        tooth0_rad: quantity("tooth0-angle-deg", &a.tooth0_angle_deg, Quantity::AngleDeg)?
             .unwrap_or(0.0)
             .to_radians(),
         cutter: a.cutter.cutter()?,
@@ -98,9 +112,10 @@ pub fn run(a: Args) -> Result<()> {
         fz_mm,
         hole_path_mm,
     };
-    a.out.check(&a.recording)?;
+    let plot = a.out.check(&a.recording, "signal")?;
     let report = signal(&req)?;
-    if let Some(p) = &a.out.plot {
+    if let Some(p) = &plot {
+        a.out.plots.create_dir()?;
         render::signal_plot(p, &report)?;
     }
     a.out.write(&report, &render::signal_text(&report))

@@ -4,7 +4,6 @@ use super::{q, EdgeFlags};
 use crate::output;
 use anyhow::{bail, Result};
 use runout::grind::{check, render, CheckRequest};
-use runout_core::grind::RangePolicy;
 use runout_io::units::Quantity;
 use std::path::PathBuf;
 
@@ -14,9 +13,21 @@ pub struct CheckArgs {
     /// Bar diameter (mm).
     #[arg(long, allow_hyphen_values = true, default_value = "6")]
     pub bar_diameter_mm: String,
-    /// Axis offset at u = 0, bar frame x,y (µm).
-    #[arg(long, allow_hyphen_values = true, default_value = "8,-4")]
-    pub offset_um: String,
+    /// Runout (axis offset) length ρ at u = 0 (µm), with --runout-angle-deg; default the offset
+    /// x,y = 8,−4 µm.
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "offset_um")]
+    pub runout_um: Option<String>,
+    /// Direction of the runout at u = 0 in the bar frame, from x towards y (deg) [default 0].
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        requires = "runout_um",
+        conflicts_with = "offset_um"
+    )]
+    pub runout_angle_deg: Option<String>,
+    /// Deprecated, use --runout-um/--runout-angle-deg: axis offset at u = 0, bar frame x,y (µm).
+    #[arg(long, hide = true, allow_hyphen_values = true)]
+    pub offset_um: Option<String>,
     /// Axis tilt x,y (µm/mm).
     #[arg(long, allow_hyphen_values = true, default_value = "0.3,0.5")]
     pub tilt_um_per_mm: String,
@@ -38,7 +49,7 @@ pub struct CheckArgs {
     /// Number of probe draws averaged (count).
     #[arg(long, default_value = "1")]
     pub draws: usize,
-    /// Random seed of the probe noise.
+    /// Random seed of the probe noise (integer).
     #[arg(long, default_value = "1")]
     pub seed: u64,
     /// Outside the probed u range: clamp | extrapolate.
@@ -61,14 +72,20 @@ fn pair(flag: &str, text: &str, quantity: Quantity) -> Result<[f64; 2]> {
 
 pub fn run(a: CheckArgs) -> Result<()> {
     let bar_diameter_mm = q("bar-diameter-mm", &a.bar_diameter_mm, Quantity::LengthMm)?;
-    let offset_um = pair("offset-um", &a.offset_um, Quantity::LengthUm)?;
+    let offset_um = match (&a.runout_um, &a.offset_um) {
+        (Some(rho), _) => runout::grind::offset_xy_um(
+            q("runout-um", rho, Quantity::LengthUm)?,
+            match &a.runout_angle_deg {
+                Some(t) => q("runout-angle-deg", t, Quantity::AngleDeg)?,
+                None => 0.0,
+            },
+        ),
+        (None, Some(xy)) => pair("offset-um", xy, Quantity::LengthUm)?,
+        (None, None) => [8.0, -4.0],
+    };
     let tilt_um_per_mm = pair("tilt-um-per-mm", &a.tilt_um_per_mm, Quantity::TiltUmPerMm)?;
     let noise_um = q("noise-um", &a.noise_um, Quantity::LengthUm)?;
-    let range = match a.outside.as_str() {
-        "clamp" => RangePolicy::Clamp,
-        "extrapolate" => RangePolicy::Extrapolate,
-        o => bail!("--outside: expected clamp | extrapolate, got `{o}`"),
-    };
+    let range = super::outside(&a.outside)?;
     let u0 = q("u-from-mm", &a.u_from_mm, Quantity::LengthMm)?;
     let u1 = q("u-to-mm", &a.u_to_mm, Quantity::LengthMm)?;
     if !a.edge.generated() {

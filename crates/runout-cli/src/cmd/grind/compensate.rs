@@ -1,7 +1,8 @@
 //! `runout grind compensate`: bar clamping-error compensation for end-mill grinding (seed 004,
 //! methods.md §5; see [`runout::grind::compensate`]).
 
-use super::{q, EdgeFlags};
+use super::{outside, q, EdgeFlags};
+use crate::flags::{choice, PlotFormat};
 use crate::output;
 use anyhow::{bail, Context, Result};
 use runout::grind::{
@@ -71,9 +72,10 @@ pub struct CompensateArgs {
     /// Write the JSON report; `-` for stdout.
     #[arg(long)]
     pub json: Option<PathBuf>,
-    /// Directory for plots: deviation_heatmap, eps_along_edge, radial_error.
-    #[arg(long)]
-    pub plots: Option<PathBuf>,
+    /// Directory for plots: deviation_heatmap, eps_along_edge, radial_error. Old spelling
+    /// `--plots` (hidden, one release).
+    #[arg(long, alias = "plots", value_name = "DIR")]
+    pub plot_dir: Option<PathBuf>,
     /// Plot format: svg | png.
     #[arg(long, default_value = "svg")]
     pub plot_format: String,
@@ -87,38 +89,71 @@ fn options(a: &CompensateArgs) -> Result<ProbeOptions> {
         },
         miss_limit_mm: q("miss-limit-um", &a.miss_limit_um, Quantity::LengthUm)? * 1e-3,
         angle_tolerance: 1e-6,
-        duplicates: match a.duplicates.as_str() {
-            "error" => DuplicatePolicy::Error,
-            "average" => DuplicatePolicy::Average,
-            o => bail!("--duplicates: expected error | average, got `{o}`"),
+        duplicates: match choice("--duplicates", &a.duplicates)? {
+            Duplicates::Error => DuplicatePolicy::Error,
+            Duplicates::Average => DuplicatePolicy::Average,
         },
-        missing: match a.missing.as_str() {
-            "error" => MissingPolicy::Error,
-            "skip" => MissingPolicy::Skip,
-            o => bail!("--missing: expected error | skip, got `{o}`"),
+        missing: match choice("--missing", &a.missing)? {
+            Missing::Error => MissingPolicy::Error,
+            Missing::Skip => MissingPolicy::Skip,
         },
     })
 }
 
 fn scheme(a: &CompensateArgs) -> Result<(Scheme, RangePolicy)> {
-    let s = match a.scheme.as_str() {
-        "first-harmonic" => Scheme::FirstHarmonic,
-        "bilinear" => Scheme::Bilinear,
-        o => bail!("--scheme: expected first-harmonic | bilinear, got `{o}`"),
+    let s = match choice("--scheme", &a.scheme)? {
+        SchemeArg::FirstHarmonic => Scheme::FirstHarmonic,
+        SchemeArg::Bilinear => Scheme::Bilinear,
     };
-    let r = match a.outside.as_str() {
-        "clamp" => RangePolicy::Clamp,
-        "extrapolate" => RangePolicy::Extrapolate,
-        o => bail!("--outside: expected clamp | extrapolate, got `{o}`"),
-    };
-    Ok((s, r))
+    Ok((s, outside(&a.outside)?))
+}
+
+/// `--duplicates`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum Duplicates {
+    Error,
+    Average,
+}
+
+/// `--missing`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum Missing {
+    Error,
+    Skip,
+}
+
+/// `--scheme`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum SchemeArg {
+    FirstHarmonic,
+    Bilinear,
+}
+
+/// `--probe-angle-sense`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum Sense {
+    Ccw,
+    Cw,
+}
+
+/// `--nc-map`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum NcMap {
+    Index,
+    Xyz,
+}
+
+/// `--nc-moves`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum NcMoves {
+    Feed,
+    All,
 }
 
 pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
-    let angle_sense = match a.probe_angle_sense.as_str() {
-        "ccw" => AngleSense::Ccw,
-        "cw" => AngleSense::Cw,
-        o => bail!("--probe-angle-sense: expected ccw | cw, got `{o}`"),
+    let angle_sense = match choice("--probe-angle-sense", &a.probe_angle_sense)? {
+        Sense::Ccw => AngleSense::Ccw,
+        Sense::Cw => AngleSense::Cw,
     };
     let generatrix = match (&a.generatrix, &a.bar_diameter_mm) {
         (Some(_), Some(_)) => bail!("give --bar-diameter-mm or --generatrix, not both"),
@@ -150,15 +185,13 @@ pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
         (Some(nc), Some(out)) => Some(NcRequest {
             program: Source::path(nc),
             output: out.display().to_string(),
-            mapping: match a.nc_map.as_str() {
-                "index" => NcMapping::Index,
-                "xyz" => NcMapping::Xyz,
-                o => bail!("--nc-map: expected index | xyz, got `{o}`"),
+            mapping: match choice("--nc-map", &a.nc_map)? {
+                NcMap::Index => NcMapping::Index,
+                NcMap::Xyz => NcMapping::Xyz,
             },
-            all_moves: match a.nc_moves.as_str() {
-                "feed" => false,
-                "all" => true,
-                o => bail!("--nc-moves: expected feed | all, got `{o}`"),
+            all_moves: match choice("--nc-moves", &a.nc_moves)? {
+                NcMoves::Feed => false,
+                NcMoves::All => true,
             },
             decimals: a.nc_decimals,
         }),
@@ -166,9 +199,10 @@ pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
         (None, Some(_)) => bail!("--out needs --nc (the program to compensate)"),
         (None, None) => None,
     };
-    if a.plots.is_some() && a.plot_format != "svg" && a.plot_format != "png" {
-        bail!("--plot-format: expected svg | png, got `{}`", a.plot_format);
-    }
+    let plot_format = match &a.plot_dir {
+        Some(_) => Some(choice::<PlotFormat>("--plot-format", &a.plot_format)?),
+        None => None,
+    };
     let report = compensate(&CompensateRequest {
         probe: Source::path(&a.probe),
         angle_sense,
@@ -186,8 +220,8 @@ pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
         render::compensate_path_csv(output::create(p)?, &report)
             .with_context(|| format!("writing {}", p.display()))?;
     }
-    if let Some(dir) = &a.plots {
-        render::compensate_plots(dir, &a.plot_format, &report)?;
+    if let (Some(dir), Some(f)) = (&a.plot_dir, plot_format) {
+        render::compensate_plots(dir, f.ext(), &report)?;
     }
     if let Some(j) = &a.json {
         output::write_text(j, &runout::to_json(&report)?)?;

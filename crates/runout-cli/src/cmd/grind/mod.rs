@@ -36,9 +36,9 @@ pub struct EdgeFlags {
     /// Edge diameter (mm) for flat/ball edges (default: the bar diameter).
     #[arg(long, allow_hyphen_values = true)]
     pub edge_diameter_mm: Option<String>,
-    /// Number of flutes K.
-    #[arg(long, default_value = "4")]
-    pub flutes: usize,
+    /// Number of teeth (flutes) K (count). Old spelling `--flutes` (hidden, one release).
+    #[arg(long, alias = "flutes", default_value = "4")]
+    pub teeth: usize,
     /// Helix angle (deg).
     #[arg(long, allow_hyphen_values = true, default_value = "30")]
     pub helix_deg: String,
@@ -61,6 +61,22 @@ pub fn run(a: Args) -> Result<()> {
         GrindCommand::Compensate(c) => compensate::compensate_cmd(*c),
         GrindCommand::Check(c) => check::run(*c),
     }
+}
+
+/// `--outside clamp|extrapolate`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum Outside {
+    Clamp,
+    Extrapolate,
+}
+
+/// `--outside`: what happens outside the probed u range.
+pub(crate) fn outside(text: &str) -> Result<runout_core::grind::RangePolicy> {
+    use runout_core::grind::RangePolicy;
+    Ok(match crate::flags::choice("--outside", text)? {
+        Outside::Clamp => RangePolicy::Clamp,
+        Outside::Extrapolate => RangePolicy::Extrapolate,
+    })
 }
 
 pub(crate) fn q(flag: &str, text: &str, quantity: Quantity) -> Result<f64> {
@@ -90,7 +106,7 @@ impl EdgeFlags {
                 .as_deref()
                 .map(|d| q("edge-diameter-mm", d, Quantity::LengthMm))
                 .transpose()?,
-            flutes: self.flutes,
+            flutes: self.teeth,
             helix_deg: q("helix-deg", &self.helix_deg, Quantity::AngleDeg)?,
             from_mm: q("edge-from-mm", &self.edge_from_mm, Quantity::LengthMm)?,
             to_mm: self

@@ -73,8 +73,11 @@ fn peaks(dir: &Path, ext: &str, i: usize, rec: &RecordingReport) -> Result<()> {
     Ok(())
 }
 
+/// A runout estimate: label, ρ (µm), λ (deg) and their SEs.
+type Mark = (String, f64, f64, Option<f64>, Option<f64>);
+
 /// Every runout estimate: the sine fit of each recording, then the full-signal fit.
-fn marks(r: &RecordingsReport) -> Vec<(String, f64, f64, Option<f64>, Option<f64>)> {
+fn marks(r: &RecordingsReport) -> Vec<Mark> {
     let mut m: Vec<_> = r
         .recordings
         .iter()

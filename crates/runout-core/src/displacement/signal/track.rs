@@ -5,6 +5,7 @@
 //! first sample when estimated.
 
 use super::super::error::{check_finite, DisplacementError};
+use crate::signal::PulseEdgeDetector;
 use realfft::RealFftPlanner;
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
@@ -126,11 +127,9 @@ pub(crate) fn from_pulse(pulse: &[f64], fs: f64) -> Result<SpindleTrack, Displac
             "the pulse channel is constant: no once-per-revolution marks".into(),
         ));
     }
-    let thr = 0.5 * (lo + hi);
-    let edges: Vec<f64> = (1..pulse.len())
-        .filter(|&i| pulse[i - 1] < thr && pulse[i] >= thr)
-        .map(|i| (i - 1) as f64 + (thr - pulse[i - 1]) / (pulse[i] - pulse[i - 1]))
-        .collect();
+    // edges in samples: the mid-level crossing on the way up, no hysteresis
+    let edges = PulseEdgeDetector::mid_level(lo, hi)
+        .edges(pulse.iter().enumerate().map(|(i, &v)| (i as f64, v)));
     if edges.len() < 2 {
         return Err(DisplacementError::Signal(format!(
             "the pulse channel has {} once-per-revolution mark(s); at least 2 (one complete revolution) are needed",
@@ -358,28 +357,12 @@ mod num_complex_like {
             self.1.atan2(self.0)
         }
     }
-    /// Complex first-harmonic amplitude Σ (x − x̄)·e^{+jφ_i} (φ_i = step·(offset + i)); the
-    /// argument is the signal's phase ϕ in x ≈ A cos(φ − ϕ)… sign-consistent for both halves.
+    /// Complex first-harmonic amplitude Σ (x − x̄)·e^{−jφ_i} (φ_i = step·(offset + i)) from
+    /// [`crate::fit::harmonic::fourier_coefficient_uniform`]: x ≈ a cos φ + b sin φ =
+    /// A cos(φ − ϕ), ϕ = atan2(b, a); the fitted phase ϕ grows with time when the true frequency
+    /// is higher, so Z = a − j·b ∝ e^{−jϕ}.
     pub fn harmonic(x: &[f64], offset: usize, step: f64) -> Z {
-        let mean = x.iter().sum::<f64>() / x.len() as f64;
-        let (ss, cs) = step.sin_cos();
-        let (mut acc_c, mut acc_s) = (0.0, 0.0);
-        let mut i = 0;
-        while i < x.len() {
-            let end = (i + 1024).min(x.len());
-            let (mut s, mut c) = (step * (offset + i) as f64).sin_cos();
-            for v in &x[i..end] {
-                let d = v - mean;
-                acc_c += d * c;
-                acc_s += d * s;
-                let c2 = c * cs - s * ss;
-                s = s * cs + c * ss;
-                c = c2;
-            }
-            i = end;
-        }
-        // x ≈ a cos φ + b sin φ = A cos(φ − ϕ), ϕ = atan2(b, a); the fitted phase ϕ grows with
-        // time when the true frequency is higher, so conj is taken: Z = a − j·b ∝ e^{−jϕ}.
-        Z(acc_c, -acc_s)
+        let (re, im) = crate::fit::harmonic::fourier_coefficient_uniform(x, offset, step);
+        Z(re, im)
     }
 }

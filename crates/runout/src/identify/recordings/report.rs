@@ -144,7 +144,7 @@ pub struct RecordingReport {
 #[serde(untagged)]
 pub enum Calibration {
     /// Coefficients with the per-component regressions.
-    Fitted(#[schemars(with = "Value")] MeanForceCalibration),
+    Fitted(#[schemars(with = "Value")] Box<MeanForceCalibration>),
     /// Why not.
     Skipped {
         /// The reason.
@@ -457,7 +457,7 @@ pub(super) fn build(
         recordings: files.iter().map(|f| recording_report(req, f)).collect(),
         mean_force_calibration: match cal {
             Err(e) => Calibration::Skipped { skipped: e.clone() },
-            Ok(k) => Calibration::Fitted(k.clone()),
+            Ok(k) => Calibration::Fitted(Box::new(k.clone())),
         },
         full_signal: fit_report(fit, files),
         measuring_chain: MeasuringChainReport {

@@ -1,0 +1,269 @@
+//! Ordinary linear least squares with covariance, and straight-line regressions.
+//!
+//! β̂ = argmin ‖y − Xβ‖² by SVD (nalgebra); with σ̂² = RSS/(n − p) the covariance is
+//! Cov(β̂) = σ̂²·(XᵀX)⁻¹ (standard errors are the square roots of its diagonal). The condition
+//! number is κ(X) = s_max/s_min, and R² = 1 − RSS/Σ(y − ȳ)².
+
+use nalgebra::{DMatrix, DVector, SVD};
+use serde::Serialize;
+use thiserror::Error;
+
+/// Why a least-squares fit could not be solved. Converts into each method's error type with the
+/// same message (e.g. [`crate::identify::IdentifyError`]).
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum FitError {
+    /// Fewer observations than needed.
+    #[error("not enough data for {what}: need {needed}, got {got}")]
+    TooFewData {
+        /// Which fit.
+        what: String,
+        /// What is needed.
+        needed: String,
+        /// What was given.
+        got: String,
+    },
+    /// The design matrix is rank deficient.
+    #[error("{what} is singular: {reason}")]
+    Singular {
+        /// Which fit.
+        what: String,
+        /// Why.
+        reason: String,
+    },
+}
+
+impl FitError {
+    pub(crate) fn too_few(what: &str, needed: impl ToString, got: impl ToString) -> Self {
+        FitError::TooFewData {
+            what: what.into(),
+            needed: needed.to_string(),
+            got: got.to_string(),
+        }
+    }
+    pub(crate) fn singular(what: &str, reason: impl ToString) -> Self {
+        FitError::Singular {
+            what: what.into(),
+            reason: reason.to_string(),
+        }
+    }
+}
+
+/// The SVD of a design matrix X, ready to solve y ≈ X·β for one or several right-hand sides.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use runout_core::fit::LinearLsq;
+/// let x = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 1.0, 1.0, 1.0, 2.0]);
+/// let lsq = LinearLsq::new(x);
+/// let fit = lsq.solve(&DVector::from_vec(vec![1.0, 3.0, 5.0]), 0.0).unwrap();
+/// assert!((fit.beta[0] - 1.0).abs() < 1e-12 && (fit.beta[1] - 2.0).abs() < 1e-12);
+/// assert!(fit.rss < 1e-20);
+/// ```
+#[derive(Debug, Clone)]
+pub struct LinearLsq {
+    x: DMatrix<f64>,
+    svd: SVD<f64, nalgebra::Dyn, nalgebra::Dyn>,
+}
+
+impl LinearLsq {
+    /// Decompose X (n × p) by SVD.
+    pub fn new(x: DMatrix<f64>) -> Self {
+        let svd = x.clone().svd(true, true);
+        Self { x, svd }
+    }
+    /// The design matrix X.
+    pub fn design(&self) -> &DMatrix<f64> {
+        &self.x
+    }
+    /// Largest singular value of X.
+    pub fn smax(&self) -> f64 {
+        self.svd.singular_values.max()
+    }
+    /// Smallest singular value of X.
+    pub fn smin(&self) -> f64 {
+        self.svd.singular_values.min()
+    }
+    /// 2-norm condition number κ(X) = s_max/s_min.
+    pub fn condition(&self) -> f64 {
+        self.smax() / self.smin()
+    }
+    /// β̂ = X⁺y by the SVD, treating singular values ≤ `eps` as zero (nalgebra's `SVD::solve`).
+    pub fn beta(&self, y: &DVector<f64>, eps: f64) -> Result<DVector<f64>, &'static str> {
+        self.svd.solve(y, eps)
+    }
+    /// (XᵀX)⁻¹ = V·S⁻²·Vᵀ from the SVD (the well-conditioned way).
+    pub fn xtx_inv(&self) -> DMatrix<f64> {
+        let v_t = self.svd.v_t.as_ref().expect("SVD computed with V");
+        let inv_s2 = DMatrix::from_diagonal(&self.svd.singular_values.map(|s| 1.0 / (s * s)));
+        v_t.transpose() * inv_s2 * v_t
+    }
+    /// (XᵀX)⁻¹ by inverting the normal matrix (LU), `None` when it is singular. Kept for the fits
+    /// whose published outputs (grind, shank calibration, chip compensation) were computed this
+    /// way; agrees with [`LinearLsq::xtx_inv`] to rounding on well-conditioned problems.
+    pub fn normal_inverse(&self) -> Option<DMatrix<f64>> {
+        (self.x.transpose() * &self.x).try_inverse()
+    }
+    /// Solve y ≈ X·β (singular values ≤ `eps` treated as zero), with residuals, RSS and the
+    /// SVD-based (XᵀX)⁻¹.
+    pub fn solve(&self, y: &DVector<f64>, eps: f64) -> Result<LinearFit, &'static str> {
+        let (n, p) = self.x.shape();
+        let beta = self.beta(y, eps)?;
+        let residuals = y - &self.x * &beta;
+        let rss = residuals.norm_squared();
+        Ok(LinearFit {
+            beta,
+            xtx_inv: self.xtx_inv(),
+            rss,
+            residuals,
+            n,
+            p,
+            condition: self.condition(),
+        })
+    }
+}
+
+/// Result of a linear least-squares fit y ≈ X·β.
+#[derive(Debug, Clone)]
+pub struct LinearFit {
+    /// Coefficients β̂.
+    pub beta: DVector<f64>,
+    /// (XᵀX)⁻¹ (unscaled covariance).
+    pub xtx_inv: DMatrix<f64>,
+    /// Residual sum of squares.
+    pub rss: f64,
+    /// Residuals y − Xβ̂.
+    pub residuals: DVector<f64>,
+    /// Number of observations n.
+    pub n: usize,
+    /// Number of coefficients p.
+    pub p: usize,
+    /// 2-norm condition number of X (largest / smallest singular value).
+    pub condition: f64,
+}
+
+impl LinearFit {
+    /// Residual degrees of freedom n − p.
+    pub fn dof(&self) -> usize {
+        self.n.saturating_sub(self.p)
+    }
+    /// σ̂² = RSS/(n − p), `None` without residual degrees of freedom.
+    pub fn sigma2(&self) -> Option<f64> {
+        (self.dof() > 0).then(|| self.rss / self.dof() as f64)
+    }
+    /// Cov(β̂) = σ̂²(XᵀX)⁻¹, `None` without residual degrees of freedom.
+    pub fn covariance(&self) -> Option<DMatrix<f64>> {
+        self.sigma2().map(|s2| &self.xtx_inv * s2)
+    }
+}
+
+/// Solve y ≈ X·β by SVD. Errors when X has fewer rows than columns or is rank deficient
+/// (relative singular value below 1e-12).
+pub fn linear_lsq(what: &str, x: &DMatrix<f64>, y: &DVector<f64>) -> Result<LinearFit, FitError> {
+    let (n, p) = x.shape();
+    if n < p {
+        return Err(FitError::too_few(what, format!("{p} observations"), n));
+    }
+    let lsq = LinearLsq::new(x.clone());
+    let (smax, smin) = (lsq.smax(), lsq.smin());
+    if smax.is_nan() || smax <= 0.0 || smin <= 1e-12 * smax {
+        return Err(FitError::singular(
+            what,
+            format!("design matrix rank deficient (singular values {smin:.3e} .. {smax:.3e})"),
+        ));
+    }
+    lsq.solve(y, 0.0).map_err(|e| FitError::singular(what, e))
+}
+
+/// Coefficient of determination R² = 1 − RSS/Σ(y − ȳ)² (1 when y is constant and fitted exactly).
+pub fn r_squared(y: &[f64], rss: f64) -> f64 {
+    let n = y.len().max(1) as f64;
+    let mean = y.iter().sum::<f64>() / n;
+    let tss: f64 = y.iter().map(|v| (v - mean).powi(2)).sum();
+    if tss > 0.0 {
+        1.0 - rss / tss
+    } else if rss <= 1e-24 {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// A straight-line regression y = slope·x (+ intercept).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Regression {
+    /// Slope.
+    pub slope: f64,
+    /// Standard error of the slope (`NaN` without residual dof).
+    pub slope_se: f64,
+    /// Intercept (0 for a fit through the origin).
+    pub intercept: f64,
+    /// Standard error of the intercept (`NaN` through the origin or without residual dof).
+    pub intercept_se: f64,
+    /// True when the intercept was fitted.
+    pub with_intercept: bool,
+    /// R² = 1 − RSS/Σ(y − ȳ)² (centred, also for the fit through the origin).
+    pub r_squared: f64,
+    /// Number of points.
+    pub n: usize,
+}
+
+/// Least-squares line y = a + b·x (`with_intercept`) or y = b·x through the origin.
+///
+/// ```
+/// use runout_core::fit::fit_line;
+/// let r = fit_line(&[1.0, 2.0, 3.0], &[3.0, 5.0, 7.0], true).unwrap();
+/// assert!((r.slope - 2.0).abs() < 1e-12 && (r.intercept - 1.0).abs() < 1e-12);
+/// ```
+pub fn fit_line(x: &[f64], y: &[f64], with_intercept: bool) -> Result<Regression, FitError> {
+    if x.len() != y.len() {
+        return Err(FitError::too_few(
+            "line fit",
+            format!("{} y values", x.len()),
+            y.len(),
+        ));
+    }
+    let p = if with_intercept { 2 } else { 1 };
+    let design = DMatrix::from_fn(x.len(), p, |r, c| if c == 0 { x[r] } else { 1.0 });
+    let fit = linear_lsq("line fit", &design, &DVector::from_column_slice(y))?;
+    let se = |i: usize| {
+        fit.covariance()
+            .map(|c| c[(i, i)].sqrt())
+            .unwrap_or(f64::NAN)
+    };
+    Ok(Regression {
+        slope: fit.beta[0],
+        slope_se: se(0),
+        intercept: if with_intercept { fit.beta[1] } else { 0.0 },
+        intercept_se: if with_intercept { se(1) } else { f64::NAN },
+        with_intercept,
+        r_squared: r_squared(y, fit.rss),
+        n: x.len(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The two ways to (XᵀX)⁻¹ agree to rounding on a well-conditioned design (κ ≈ 10):
+    /// relative 1e-12 is ~10⁴ ulps, far above the κ²·ε ≈ 1e-14 expected difference.
+    #[test]
+    fn svd_and_normal_inverse_agree() {
+        let x = DMatrix::from_fn(20, 3, |r, c| {
+            ((r as f64) * 0.37 + c as f64).sin() + (c == 0) as u8 as f64
+        });
+        let lsq = LinearLsq::new(x);
+        let a = lsq.xtx_inv();
+        let b = lsq.normal_inverse().unwrap();
+        assert!((a - &b).amax() <= 1e-12 * b.amax());
+    }
+
+    #[test]
+    fn rank_deficient_is_an_error_naming_the_fit() {
+        let x = DMatrix::from_fn(5, 2, |r, _| r as f64);
+        let e = linear_lsq("demo fit", &x, &DVector::zeros(5)).unwrap_err();
+        assert!(e
+            .to_string()
+            .starts_with("demo fit is singular: design matrix rank deficient"));
+    }
+}
