@@ -312,7 +312,7 @@ fn cutter(
     helix_deg: f64,
 ) -> PyResult<Option<runout_core::Cutter>> {
     match (teeth, diameter_mm) {
-        (Some(k), Some(d)) => runout_core::Cutter::flat(d, k, helix_deg)
+        (Some(k), Some(d)) => runout_core::Cutter::flat(d, k, helix_deg.to_radians())
             .map(Some)
             .map_err(|e| RunoutError::new_err(e.to_string())),
         (None, None) => Ok(None),
