@@ -39,6 +39,8 @@ enum Command {
     Grind(cmd::grind::Args),
     /// Cutting force and runout from two-point shank deflection (capacitive sensors).
     Shank(cmd::shank::Args),
+    /// Identify many recordings (folder or glob) in parallel into one summary table; resumable.
+    Batch(cmd::batch::Args),
     /// What a recording holds (.mat, TDMS, HDF5, Parquet, CSV): channels, units, lengths, rates.
     Inspect(cmd::inspect::Args),
     /// Shell completions (bash, zsh, fish, elvish, powershell) to stdout.
@@ -101,6 +103,7 @@ fn main() -> ExitCode {
             cmd::install::completions(a, <Cli as clap::CommandFactory>::command())
         }
         Command::Man(a) => cmd::install::man(a, <Cli as clap::CommandFactory>::command()),
+        Command::Batch(a) => cmd::batch::run(a),
     };
     // outputs appear only when the whole command succeeded (or only its stdout was cut short)
     let result = match result {

@@ -51,6 +51,7 @@ pub struct Source {
 enum Kind {
     Path(PathBuf),
     Bytes(Arc<[u8]>),
+    Arrays(Arc<runout_io::formats::Arrays>),
 }
 
 impl Source {
@@ -71,6 +72,17 @@ impl Source {
         }
     }
 
+    /// Named arrays in memory (NumPy arrays from the Python package), named `name` in messages:
+    /// a recording (read without a round trip through text; `t`/`time_s` is the time vector, a
+    /// one-value `fs` the sample rate), or a table whose columns are the arrays (a CSV with one
+    /// column per array, values written exactly, for the table readers).
+    pub fn arrays(name: impl Into<String>, arrays: runout_io::formats::Arrays) -> Self {
+        Self {
+            name: name.into(),
+            kind: Kind::Arrays(Arc::new(arrays)),
+        }
+    }
+
     /// The name used in messages and reports (the path as given, for a file).
     pub fn name(&self) -> &str {
         &self.name
@@ -80,7 +92,7 @@ impl Source {
     pub fn as_path(&self) -> Option<&Path> {
         match &self.kind {
             Kind::Path(p) => Some(p),
-            Kind::Bytes(_) => None,
+            Kind::Bytes(_) | Kind::Arrays(_) => None,
         }
     }
 
@@ -106,6 +118,7 @@ impl Source {
         match &self.kind {
             Kind::Path(p) => runout_io::textfile::read_text(p),
             Kind::Bytes(b) => runout_io::textfile::text_from_bytes(&self.name, b.to_vec()),
+            Kind::Arrays(a) => runout_io::textfile::text_from_bytes(&self.name, arrays_csv(a)),
         }
     }
 
@@ -118,6 +131,14 @@ impl Source {
                 reader: Box::new(&b[..]),
                 len: Some(b.len() as u64),
             },
+            Kind::Arrays(a) => {
+                let csv = arrays_csv(a);
+                runout_io::displacement::TableInput::Reader {
+                    name: &self.name,
+                    len: Some(csv.len() as u64),
+                    reader: Box::new(std::io::Cursor::new(csv)),
+                }
+            }
         }
     }
 
@@ -135,8 +156,37 @@ impl Source {
                 Ok(RecordingReader::from_reader(src, &self.name, options)?
                     .with_file_bytes(Some(b.len() as u64)))
             }
+            Kind::Arrays(a) => {
+                Ok(runout_io::formats::recording_from_arrays(&self.name, a, options)?.boxed())
+            }
         }
     }
+}
+
+/// Arrays as a CSV table: the names as the header row, one row per index (shorter arrays leave
+/// their cells empty), every value in Rust's shortest round-trip form (read back exactly).
+fn arrays_csv(a: &runout_io::formats::Arrays) -> Vec<u8> {
+    use std::fmt::Write;
+    let rows = a.columns.iter().map(|(_, v)| v.len()).max().unwrap_or(0);
+    let mut s = a
+        .columns
+        .iter()
+        .map(|(n, _)| n.as_str())
+        .collect::<Vec<_>>()
+        .join(",");
+    s.push('\n');
+    for i in 0..rows {
+        for (k, (_, v)) in a.columns.iter().enumerate() {
+            if k > 0 {
+                s.push(',');
+            }
+            if let Some(x) = v.get(i) {
+                let _ = write!(s, "{x}");
+            }
+        }
+        s.push('\n');
+    }
+    s.into_bytes()
 }
 
 #[cfg(test)]
@@ -181,6 +231,31 @@ mod tests {
         assert_eq!(Source::path(&p).read_text().unwrap(), text);
         assert_eq!(Source::path(&p).dir(), dir.path());
         assert_eq!(Source::bytes("x", &b""[..]).dir(), Path::new("."));
+    }
+
+    #[test]
+    fn arrays_are_a_recording_and_a_table() {
+        let t: Vec<f64> = (0..100).map(|k| k as f64 * 0.001).collect();
+        let a: Vec<f64> = t.iter().map(|t| 0.1 + t * t).collect();
+        let arrays = runout_io::formats::Arrays {
+            columns: vec![
+                ("time_s".into(), Arc::from(t.as_slice())),
+                ("a_um".into(), Arc::from(a.as_slice())),
+            ],
+        };
+        let s = Source::arrays("numpy", arrays);
+        let mut r = s.open_recording(&ReadOptions::new()).unwrap();
+        assert_eq!(r.info().file, "numpy");
+        let mut chunk = runout_io::recording::Chunk::default();
+        r.read_chunk(&mut chunk, 1000).unwrap();
+        assert_eq!(chunk.channel(0), &a[..]);
+        // as text: the same values, exactly, through a CSV reader
+        let text = s.read_text().unwrap();
+        let mut r =
+            RecordingReader::from_bytes("csv", text.as_bytes(), &ReadOptions::new()).unwrap();
+        r.read_chunk(&mut chunk, 1000).unwrap();
+        assert_eq!(chunk.channel(0), &a[..]);
+        assert!(s.as_path().is_none());
     }
 
     #[test]

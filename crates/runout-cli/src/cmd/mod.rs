@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod batch;
 pub mod chip;
 pub mod displacement;
 pub mod grind;

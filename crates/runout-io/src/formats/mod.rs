@@ -16,6 +16,7 @@
 //! (`rec600.Fx` as `Fx`), or the arrays named `NAME_SEL` (`Fx_600` as `Fx`), so one axis mapping
 //! (`x = -Fx, y = -Fy`) serves every recording in a "one file, five feeds" file.
 
+pub mod arrays;
 pub mod detect;
 pub mod hdf5;
 pub mod mat;
@@ -23,6 +24,7 @@ pub mod mat;
 pub mod parquet;
 pub mod tdms;
 
+pub use arrays::{recording_from_arrays, Arrays};
 pub use detect::{detect, detect_file, Kind};
 
 use crate::recording::{

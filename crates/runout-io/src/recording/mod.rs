@@ -27,7 +27,7 @@
 
 mod axis;
 mod error;
-mod header;
+pub(crate) mod header;
 mod reader;
 mod text;
 mod writer;
@@ -139,6 +139,8 @@ pub enum Format {
     Hdf5,
     /// An Apache Parquet file.
     Parquet,
+    /// Arrays in memory (the Python package's NumPy arrays, [`crate::formats::Arrays`]).
+    Arrays,
 }
 
 /// One column of the header.

@@ -38,6 +38,8 @@ pub enum FormatReport {
     },
     Hdf5,
     Parquet,
+    /// Arrays in memory (the Python package's NumPy arrays; `runout_io::formats::Arrays`).
+    Arrays,
 }
 
 impl From<&Format> for FormatReport {
@@ -53,6 +55,7 @@ impl From<&Format> for FormatReport {
             Format::Tdms { version } => Self::Tdms { version: *version },
             Format::Hdf5 => Self::Hdf5,
             Format::Parquet => Self::Parquet,
+            Format::Arrays => Self::Arrays,
         }
     }
 }
