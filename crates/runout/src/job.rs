@@ -96,11 +96,19 @@ impl Source {
         }
     }
 
-    /// The bytes, if the source is held in memory.
+    /// The bytes, if the source is bytes held in memory.
     pub fn as_bytes(&self) -> Option<&[u8]> {
         match &self.kind {
-            Kind::Path(_) => None,
+            Kind::Path(_) | Kind::Arrays(_) => None,
             Kind::Bytes(b) => Some(b),
+        }
+    }
+
+    /// The named arrays, if the source is arrays held in memory.
+    pub fn as_arrays(&self) -> Option<&runout_io::formats::Arrays> {
+        match &self.kind {
+            Kind::Arrays(a) => Some(a),
+            Kind::Path(_) | Kind::Bytes(_) => None,
         }
     }
 

@@ -43,7 +43,8 @@ pub struct Provenance {
 pub struct InputFile {
     /// The name the input was given by (a path as typed, or the name of in-memory bytes).
     pub name: String,
-    /// Size in bytes.
+    /// Size in bytes (for named arrays: of their hashed form — each name, a NUL byte, and the
+    /// samples as little-endian f64).
     pub size_bytes: u64,
     /// SHA-256 of the content, lower-case hex (64 characters).
     pub sha256: String,
@@ -103,11 +104,26 @@ impl InputFile {
                 }
                 total
             }
-            None => {
-                let bytes = source.as_bytes().unwrap_or_default();
-                hasher.update(bytes);
-                bytes.len() as u64
-            }
+            None => match source.as_arrays() {
+                // arrays: each channel's name, a NUL, then its samples as little-endian f64
+                Some(arrays) => {
+                    let mut total = 0u64;
+                    for (name, samples) in &arrays.columns {
+                        hasher.update(name.as_bytes());
+                        hasher.update([0u8]);
+                        for v in samples.iter() {
+                            hasher.update(v.to_le_bytes());
+                        }
+                        total += name.len() as u64 + 1 + 8 * samples.len() as u64;
+                    }
+                    total
+                }
+                None => {
+                    let bytes = source.as_bytes().unwrap_or_default();
+                    hasher.update(bytes);
+                    bytes.len() as u64
+                }
+            },
         };
         Ok(Self {
             name: source.name().to_string(),
