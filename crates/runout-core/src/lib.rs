@@ -35,6 +35,7 @@ pub mod plausibility;
 pub mod runout;
 pub mod shank;
 pub mod signal;
+pub mod verdict;
 
 pub use chip::{ArcChip, ChipAtHeight, ChipThickness, EquivalentChip, ExactChip};
 pub use coefficients::CuttingCoefficients;
