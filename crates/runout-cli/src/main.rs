@@ -38,6 +38,8 @@ enum Command {
     Shank(cmd::shank::Args),
     /// What a recording holds (.mat, TDMS, HDF5, Parquet, CSV): channels, units, lengths, rates.
     Inspect(cmd::inspect::Args),
+    /// Render saved JSON reports as one self-contained HTML page (verdict, comparison table).
+    Report(cmd::report::Args),
 }
 
 /// Status of a command whose standard output was closed early (`runout … | head -1`), as a
@@ -84,6 +86,7 @@ fn main() -> ExitCode {
         Command::Grind(a) => cmd::grind::run(a),
         Command::Shank(a) => cmd::shank::run(a),
         Command::Inspect(a) => cmd::inspect::run(a),
+        Command::Report(a) => cmd::report::run(a),
     };
     // outputs appear only when the whole command succeeded (or only its stdout was cut short)
     let result = match result {

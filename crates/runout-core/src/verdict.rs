@@ -170,11 +170,19 @@ pub fn verdict(input: &VerdictInput) -> Result<Verdict, ParamError> {
     let se = input.offset_se_mm;
     if let Some(s) = se {
         if !(s.is_finite() && s >= 0.0) {
-            return Err(ParamError::new("offset_se_um", "a finite SE >= 0 µm", s * 1e3));
+            return Err(ParamError::new(
+                "offset_se_um",
+                "a finite SE >= 0 µm",
+                s * 1e3,
+            ));
         }
     }
     if !input.height_mm.is_finite() {
-        return Err(ParamError::new("height_mm", "a finite height", input.height_mm));
+        return Err(ParamError::new(
+            "height_mm",
+            "a finite height",
+            input.height_mm,
+        ));
     }
     let (tol, source) = match input.tolerance_tir_mm {
         Some(t) if t.is_finite() && t > 0.0 => (t, "given".to_string()),
@@ -248,16 +256,16 @@ pub fn verdict(input: &VerdictInput) -> Result<Verdict, ParamError> {
         .collect();
     if let (Some(h), Some(fz)) = (&chips, input.fz_mm) {
         // the first of equal maxima (no runout: tooth 0)
-        let (imax, hmax) = h
-            .iter()
-            .enumerate()
-            .fold((0, f64::NEG_INFINITY), |(bi, bh), (i, &x)| {
-                if x > bh * (1.0 + 1e-12) {
-                    (i, x)
-                } else {
-                    (bi, bh)
-                }
-            });
+        let (imax, hmax) =
+            h.iter()
+                .enumerate()
+                .fold((0, f64::NEG_INFINITY), |(bi, bh), (i, &x)| {
+                    if x > bh * (1.0 + 1e-12) {
+                        (i, x)
+                    } else {
+                        (bi, bh)
+                    }
+                });
         v.max_chip_mm = Some(hmax);
         v.most_loaded_tooth = Some(imax);
         v.idle_teeth = (0..h.len()).filter(|&i| h[i] <= 0.0).collect();
@@ -413,10 +421,16 @@ mod tests {
     fn bad_inputs_are_named() {
         let mut i = input(4, 5.0, 0.0, 0.05);
         i.tolerance_tir_mm = Some(0.0);
-        assert!(verdict(&i).unwrap_err().to_string().contains("tolerance_um"));
+        assert!(verdict(&i)
+            .unwrap_err()
+            .to_string()
+            .contains("tolerance_um"));
         let mut i = input(4, 5.0, 0.0, 0.05);
         i.offset_se_mm = Some(f64::NAN);
-        assert!(verdict(&i).unwrap_err().to_string().contains("offset_se_um"));
+        assert!(verdict(&i)
+            .unwrap_err()
+            .to_string()
+            .contains("offset_se_um"));
         assert!(axis_split([0.0; 2], [0.0; 2], 0.0)
             .unwrap_err()
             .to_string()

@@ -2,7 +2,7 @@
 //! runout vector, and runout vs height with the regression line.
 
 use crate::plot::{colour, e2s, PlotError};
-use crate::render_plot;
+use crate::{render_plot, render_svg};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::f64::consts::TAU;
@@ -31,6 +31,13 @@ pub struct TeethPlot {
 /// drawn is `base + deviation` with base = 3·max(|dev|, ρ) so that deviations stay visible.
 pub fn teeth_polar_plot(path: &Path, d: &TeethPlot) -> Result<(), PlotError> {
     render_plot!(path, (760, 760), |root: &DrawingArea<_, Shift>| draw_teeth(
+        root, d
+    ))
+}
+
+/// [`teeth_polar_plot`] as an SVG document in memory.
+pub fn teeth_polar_svg(d: &TeethPlot) -> Result<String, PlotError> {
+    render_svg!((760, 760), |root: &DrawingArea<_, Shift>| draw_teeth(
         root, d
     ))
 }
@@ -172,6 +179,13 @@ pub fn height_plot(path: &Path, d: &HeightPlot) -> Result<(), PlotError> {
     render_plot!(path, (900, 560), |root: &DrawingArea<_, Shift>| {
         draw_heights(root, d)
     })
+}
+
+/// [`height_plot`] as an SVG document in memory.
+pub fn height_svg(d: &HeightPlot) -> Result<String, PlotError> {
+    render_svg!((900, 560), |root: &DrawingArea<_, Shift>| draw_heights(
+        root, d
+    ))
 }
 
 fn draw_heights<DB: DrawingBackend>(

@@ -23,10 +23,12 @@
 pub mod chip;
 pub mod displacement;
 pub mod grind;
+pub mod html;
 pub mod job;
 pub mod schema;
 pub mod shank;
 pub mod spill;
+pub mod verdict;
 
 pub use job::{to_json, NoProgress, Progress, Report, Source};
 pub use runout_core as core;

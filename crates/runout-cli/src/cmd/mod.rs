@@ -5,6 +5,7 @@ pub mod displacement;
 pub mod grind;
 pub mod identify;
 pub mod inspect;
+pub mod report;
 pub mod shank;
 pub mod simulate;
 pub mod simulate_sensor;

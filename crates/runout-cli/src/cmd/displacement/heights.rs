@@ -30,11 +30,12 @@ pub fn run(a: Args) -> Result<()> {
         Some(o) => bail!("--method: `{o}` is not `ols` or `eq6`"),
     };
     a.out.check(&a.table)?;
-    let report = heights(&HeightsRequest {
+    let mut report = heights(&HeightsRequest {
         table: Source::path(&a.table),
         at_mm,
         method,
     })?;
+    a.out.report.judge(&mut report)?;
     if let Some(p) = &a.out.plot {
         render::heights_plot(p, &report)?;
     }

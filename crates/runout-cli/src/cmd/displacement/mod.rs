@@ -53,19 +53,30 @@ pub struct OutputFlags {
     /// Plot (.svg or .png).
     #[arg(long, allow_hyphen_values = true)]
     pub plot: Option<PathBuf>,
+    #[command(flatten)]
+    pub report: crate::cmd::report::ReportFlags,
 }
 
 impl OutputFlags {
     /// Refuse outputs that overwrite `input`.
     pub fn check(&self, input: &Path) -> Result<()> {
-        for out in [&self.json, &self.text, &self.plot].into_iter().flatten() {
+        let html = self.report.html.clone();
+        for out in [&self.json, &self.text, &self.plot, &html]
+            .into_iter()
+            .flatten()
+        {
             crate::output::check_not_input(out, &[input])?;
         }
         Ok(())
     }
 
     /// Write JSON and text (text to stdout unless the JSON goes there).
-    pub fn write<R: runout::Report>(&self, report: &R, text: &str) -> Result<()> {
+    pub fn write<R: runout::Report + runout::html::ToSection>(
+        &self,
+        report: &R,
+        text: &str,
+    ) -> Result<()> {
+        self.report.write(report)?;
         if let Some(j) = &self.json {
             crate::output::write_text(j, &runout::to_json(report)?)?;
         }

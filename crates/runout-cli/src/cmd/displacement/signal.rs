@@ -99,7 +99,8 @@ pub fn run(a: Args) -> Result<()> {
         hole_path_mm,
     };
     a.out.check(&a.recording)?;
-    let report = signal(&req)?;
+    let mut report = signal(&req)?;
+    a.out.report.judge(&mut report)?;
     if let Some(p) = &a.out.plot {
         render::signal_plot(p, &report)?;
     }
