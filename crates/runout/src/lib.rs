@@ -24,6 +24,7 @@ pub mod chip;
 pub mod displacement;
 pub mod grind;
 pub mod html;
+pub mod identify;
 pub mod job;
 pub mod schema;
 pub mod shank;

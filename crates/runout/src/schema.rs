@@ -31,5 +31,8 @@ pub fn all() -> Vec<(&'static str, String, String)> {
         one::<crate::chip::EvalReport>(),
         one::<crate::grind::CompensateReport>(),
         one::<crate::grind::CheckReport>(),
+        one::<crate::identify::PeaksReport>(),
+        one::<crate::identify::TestsReport>(),
+        one::<crate::identify::RecordingsReport>(),
     ]
 }

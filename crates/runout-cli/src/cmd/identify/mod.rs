@@ -4,6 +4,7 @@
 //! CSV/TOML table: per-test fits, regressions, K_T/K_R, pooled edge-aware fit).
 
 pub mod peaks;
+mod plots;
 pub mod recording;
 pub mod tests;
 
@@ -41,10 +42,17 @@ pub fn run(a: Args) -> Result<()> {
     }
 }
 
-/// Format an optional standard error as `± x` (or "(no SE)").
-pub fn pm(se: Option<f64>, digits: usize) -> String {
-    match se {
-        Some(s) if s.is_finite() => format!("± {s:.digits$}"),
-        _ => "(no SE)".to_string(),
+/// Write the JSON (`-` = stdout) and print the text unless the JSON went to stdout.
+fn emit<R: runout::Report>(
+    json: Option<&std::path::Path>,
+    report: &R,
+    text: impl FnOnce() -> String,
+) -> Result<()> {
+    if let Some(p) = json {
+        crate::output::write_text(p, &runout::to_json(report)?)?;
     }
+    if json != Some(std::path::Path::new("-")) {
+        print!("{}", text());
+    }
+    Ok(())
 }

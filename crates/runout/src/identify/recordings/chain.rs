@@ -1,7 +1,9 @@
 //! The measuring chain, tooth numbering across recordings, per-recording consistency and the
-//! verdict per parameter for `runout identify RECORDING…` (issue 11 items 1, 3, 5).
+//! verdict per parameter for `identify RECORDING…` (issue 11 items 1, 3, 5; methods.md §4.7).
 
-use super::{waveform_case, FileResult};
+use super::fit::waveform_case;
+use super::{ChainChoice, FileResult, RecordingsRequest};
+use crate::job::Source;
 use runout_core::angle::wrap_pi;
 use runout_core::chain::{AxisChain, MeasuringChain, SensorMode};
 use runout_core::identify::{
@@ -9,7 +11,7 @@ use runout_core::identify::{
     FullSignalOptions, RunoutObservability,
 };
 use runout_core::signal::ToothReference;
-use runout_io::config::identify::IdentifyCase;
+use schemars::JsonSchema;
 use serde::Serialize;
 use std::f64::consts::TAU;
 
@@ -28,8 +30,8 @@ const AUTO_MIN_F: f64 = 50.0;
 const AUTO_MAX_DAMPING: f64 = 0.3;
 
 /// What was decided about the measuring chain, as reported.
-#[derive(Debug, Clone, Serialize)]
-pub(super) struct ChainDecision {
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct ChainDecision {
     /// What the user asked for: auto | rigid | modes | frf | band.
     pub requested: String,
     /// What the reported fit used: rigid | fitted_modes | measured_frf | band_limit.
@@ -57,7 +59,7 @@ fn axes_of(files: &[FileResult]) -> Vec<FitAxis> {
 
 /// Options of a chain fit of `files` with `model`.
 pub(super) fn chain_options(
-    case: &IdentifyCase,
+    case: &RecordingsRequest,
     files: &[FileResult],
     model: ChainModel,
     initial: Option<[f64; 2]>,
@@ -87,7 +89,7 @@ pub(super) fn chain_options(
 }
 
 /// The fitted-modes model with the user's start values (one, or per axis).
-fn fitted_modes(case: &IdentifyCase, files: &[FileResult]) -> ChainModel {
+fn fitted_modes(case: &RecordingsRequest, files: &[FileResult]) -> ChainModel {
     let axes = axes_of(files);
     let start = |i: usize| {
         case.sensor_mode_hz.as_ref().map(|v| {
@@ -167,11 +169,11 @@ type Selected = (
 );
 
 pub(super) fn select_chain(
-    case: &IdentifyCase,
+    case: &RecordingsRequest,
     files: &mut [FileResult],
     rigid: Result<FullSignalFit, String>,
 ) -> Result<Selected, anyhow::Error> {
-    let requested = case.chain.clone();
+    let requested = case.chain.name().to_string();
     let initial = rigid
         .as_ref()
         .ok()
@@ -185,20 +187,16 @@ pub(super) fn select_chain(
         band_rigid_r_squared: None,
     };
     let teeth = case.cutter.teeth();
-    let model = match requested.as_str() {
-        "rigid" => return Ok((rigid, decision, None)),
-        "frf" => {
-            let path = case.sensor_frf.as_deref().unwrap_or_default();
-            let chain = runout_io::frf::read_frf(std::path::Path::new(path))?;
-            ChainModel::Known(chain)
-        }
-        "band" => ChainModel::BandLimit {
-            max_harmonic: match case.max_harmonic {
-                Some(m) => m,
+    let model = match &case.chain {
+        ChainChoice::Rigid => return Ok((rigid, decision, None)),
+        ChainChoice::Frf(src) => ChainModel::Known(read_frf(src)?),
+        ChainChoice::Band(max) => ChainModel::BandLimit {
+            max_harmonic: match max {
+                Some(m) => *m,
                 None => auto_band(case, files, initial)?,
             },
         },
-        _ => fitted_modes(case, files),
+        ChainChoice::Auto | ChainChoice::Modes => fitted_modes(case, files),
     };
     let given = match &model {
         ChainModel::Known(c) => Some(c.clone()),
@@ -299,10 +297,18 @@ pub(super) fn select_chain(
     Ok((Ok(chain_fit), decision, given))
 }
 
+/// A measured FRF from a file or bytes.
+fn read_frf(src: &Source) -> Result<MeasuringChain, anyhow::Error> {
+    Ok(match src.as_path() {
+        Some(p) => runout_io::frf::read_frf(p)?,
+        None => runout_io::frf::parse_frf(src.name(), &src.read_text()?)?,
+    })
+}
+
 /// Automatic band limit: fit one mode per axis and keep the harmonics where the fitted chain
 /// changes the waveform by < 5 % (|H − 1| < 0.05), at least K + 1.
 fn auto_band(
-    case: &IdentifyCase,
+    case: &RecordingsRequest,
     files: &[FileResult],
     initial: Option<[f64; 2]>,
 ) -> Result<usize, anyhow::Error> {
@@ -334,7 +340,7 @@ fn auto_band(
 /// the other tooth flips it. Each recording is tried on every branch θ₀ + j·2π/K against the
 /// joint fit's runout (coefficients re-solved for that recording); returns the recordings moved.
 pub(super) fn align_tooth_numbering(
-    case: &IdentifyCase,
+    case: &RecordingsRequest,
     files: &mut [FileResult],
     fit: &FullSignalFit,
 ) -> Vec<(usize, usize)> {
@@ -363,8 +369,8 @@ pub(super) fn align_tooth_numbering(
 }
 
 /// One recording's runout with the coefficients (and chain) of the joint fit held.
-#[derive(Debug, Clone, Serialize)]
-pub(super) struct RecordingRunout {
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct RecordingRunout {
     pub file: String,
     pub offset_um: f64,
     pub offset_um_se: Option<f64>,
@@ -376,8 +382,8 @@ pub(super) struct RecordingRunout {
 }
 
 /// Spread of the per-recording runouts.
-#[derive(Debug, Clone, Serialize)]
-pub(super) struct Consistency {
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct Consistency {
     pub recordings: Vec<RecordingRunout>,
     /// (max − min)/mean of ρ over the recordings (%).
     pub offset_spread_percent: f64,
@@ -390,7 +396,7 @@ pub(super) struct Consistency {
 /// cannot separate shear from edge coefficients). A recording disagrees when its runout vector is
 /// more than max(3 SE, 15 % of ρ) from the joint one — e.g. a tool re-clamped between cuts.
 pub(super) fn consistency(
-    case: &IdentifyCase,
+    case: &RecordingsRequest,
     files: &[FileResult],
     joint: &FullSignalFit,
     given: Option<&MeasuringChain>,
@@ -417,7 +423,7 @@ pub(super) fn consistency(
         let se = fit.offset.se.unwrap_or(0.0);
         let valid = |s: Option<f64>| s.filter(|v| v.is_finite() && *v > 0.0);
         recs.push(RecordingRunout {
-            file: f.path.display().to_string(),
+            file: f.name.clone(),
             offset_um: fit.offset.value * 1e3,
             offset_um_se: valid(fit.offset.se).map(|s| s * 1e3),
             angle_deg: fit.angle.value.to_degrees(),
@@ -464,16 +470,16 @@ pub(super) fn consistency(
 }
 
 /// Reasons that concern the whole fit (printed once), and the status per parameter.
-#[derive(Debug, Clone, Serialize, Default)]
-pub(super) struct Verdicts {
+#[derive(Debug, Clone, Serialize, Default, JsonSchema)]
+pub struct Verdicts {
     /// Reasons for which no parameter of the fit is identified.
     pub fit: Vec<String>,
     pub parameters: Vec<Status>,
 }
 
 /// Status of one identified quantity.
-#[derive(Debug, Clone, Serialize)]
-pub(super) struct Status {
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+pub struct Status {
     pub parameter: String,
     /// `identified` or `not_identified`.
     pub status: String,
@@ -485,7 +491,7 @@ pub(super) struct Status {
 /// A parameter is not identified when its SE exceeds this fraction of its value (ρ and the
 /// coefficients), the angle's SE exceeds 15°, the fit explains < 90 % of the waveform, or it is
 /// physically implausible (a negative shear or edge coefficient).
-pub(super) const SE_FRACTION: f64 = 0.25;
+const SE_FRACTION: f64 = 0.25;
 const ANGLE_SE_DEG: f64 = 15.0;
 
 /// Verdicts for ρ, λ and the six coefficients, with the likely cause in words.

@@ -1,0 +1,240 @@
+//! Reading one recording: pass 1 over the source with a binary spill of the workpiece-frame
+//! forces (and pulse), passes 2 and 3 over the spill (`runout_core::signal::analyse_replay`).
+
+use super::fit::peak_sine_fit;
+use super::{FileResult, RecordingsRequest};
+use crate::job::{Progress, Source};
+use crate::spill::Spill;
+use anyhow::{bail, Context, Result};
+use runout_core::signal::{self, Component, PulseConfig, SignalConfig};
+use runout_core::Cut;
+use runout_io::recording::{
+    Axis, AxisMapping, Chunk, ReadOptions, RecordingInfo, RecordingReader, ResolvedAxes,
+};
+use runout_io::units::Quantity;
+use std::io::BufRead;
+
+/// Rows per chunk of pass 1.
+const ROWS: usize = 65_536;
+
+/// Force unit factor to N for a channel, from its unit (none = N).
+fn force_factor(info: &RecordingInfo, channel: &str) -> Result<f64> {
+    let idx = info
+        .channel_index(channel)
+        .with_context(|| format!("{}: no channel `{channel}`", info.file))?;
+    match &info.channels[idx].unit {
+        None => Ok(1.0),
+        Some(u) => Quantity::ForceN.unit_factor(u).ok_or_else(|| {
+            anyhow::anyhow!(
+                "{}: channel `{channel}` has unit `{u}`, expected a force (N or kN)",
+                info.file
+            )
+        }),
+    }
+}
+
+/// How the channels of a recording become the workpiece-frame forces.
+struct Channels {
+    mapping: AxisMapping,
+    axes: ResolvedAxes,
+    factors: Vec<f64>,
+    pulse: Option<usize>,
+}
+
+fn channels(name: &str, info: &RecordingInfo, req: &RecordingsRequest) -> Result<Channels> {
+    let names: Vec<String> = info.channels.iter().map(|c| c.name.clone()).collect();
+    let mapping = match &req.axes {
+        Some(t) => AxisMapping::parse(t)?,
+        None => AxisMapping::identity_for(&names).map_err(|e| {
+            anyhow::anyhow!(
+                "{e}; give the mapping with --axes (e.g. \"x = Fx, y = Fy, z = Fz\"); channels: {}",
+                names.join(", ")
+            )
+        })?,
+    };
+    let axes = mapping.resolve(info)?;
+    if !(axes.has(Axis::X) && axes.has(Axis::Y)) {
+        bail!("{name}: the axis mapping `{mapping}` must give both x and y");
+    }
+    let factors: Vec<f64> = Axis::ALL
+        .iter()
+        .map(|&ax| {
+            mapping
+                .source(ax)
+                .map(|s| force_factor(info, &s.channel))
+                .transpose()
+                .map(|f| f.unwrap_or(1.0))
+        })
+        .collect::<Result<_>>()?;
+    let pulse = match &req.pulse_channel {
+        Some(p) => Some(info.channel_index(p).with_context(|| {
+            format!(
+                "{name}: no pulse channel `{p}` (channels: {})",
+                names.join(", ")
+            )
+        })?),
+        None => None,
+    };
+    Ok(Channels {
+        mapping,
+        axes,
+        factors,
+        pulse,
+    })
+}
+
+fn signal_config(
+    info: &RecordingInfo,
+    req: &RecordingsRequest,
+    cut: &Cut,
+    pulse: bool,
+) -> Result<SignalConfig> {
+    let mut cfg = SignalConfig::new(info.sample_rate_hz, req.cutter.teeth(), cut.rpm())?;
+    cfg.section_s = req.section_s;
+    cfg.peak_component = req.peak_component;
+    cfg.entry_angle_rad = Some(cut.immersion(&req.cutter).0);
+    if pulse {
+        cfg.pulse = Some(PulseConfig {
+            pulses_per_rev: req.pulses_per_rev,
+            tooth0_angle_rad: req.tooth0_angle(),
+            ..PulseConfig::once_per_rev()
+        });
+    }
+    cfg.validate()?;
+    Ok(cfg)
+}
+
+/// One recording through the signal pipeline and the sine fit of its peaks.
+pub(super) fn analyse(
+    src: &Source,
+    req: &RecordingsRequest,
+    cut: &Cut,
+    progress: &mut dyn Progress,
+) -> Result<FileResult> {
+    let mut opts = ReadOptions::new();
+    if let Some(fs) = req.sample_rate_hz {
+        opts = opts.sample_rate_hz(fs);
+    }
+    let mut reader = src.open_recording(&opts)?;
+    let info = reader.info().clone();
+    let ch = channels(src.name(), &info, req)?;
+    let cfg = signal_config(&info, req, cut, ch.pulse.is_some())?;
+    let columns = 3 + ch.pulse.is_some() as usize;
+    let path = Spill::temp_path("identify");
+    let mut spill = Spill::create(path.clone(), columns)
+        .with_context(|| format!("creating temporary file {}", path.display()))?;
+    let total =
+        info.file_bytes.unwrap_or(0) + 2 * 8 * columns as u64 * info.expected_samples.unwrap_or(0);
+    progress.begin(src.name(), Some(total));
+    let has_z = ch.axes.has(Axis::Z);
+    let mut pass = 0;
+    let analysis = signal::analyse_replay::<anyhow::Error, _>(&cfg, |sink| {
+        pass += 1;
+        if pass == 1 {
+            first_pass(&mut reader, &ch, &mut spill, progress, sink)
+        } else {
+            replay(&mut spill, has_z, progress, sink)
+        }
+    })?;
+    progress.end();
+    let reader_warnings = reader.warnings().to_vec();
+    let avg = &analysis.average;
+    let mean = |c: Component| {
+        let m = &avg.component(c).mean;
+        m.iter().sum::<f64>() / m.len().max(1) as f64
+    };
+    let fz = if avg.has_fz {
+        mean(Component::Fz)
+    } else {
+        f64::NAN
+    };
+    let mean_force = [mean(Component::Fx), mean(Component::Fy), fz];
+    let sine = peak_sine_fit(&req.cutter, cut, &analysis);
+    Ok(FileResult {
+        name: src.name().to_string(),
+        info,
+        axes: ch.mapping.to_string(),
+        cut: *cut,
+        analysis,
+        mean_force,
+        start_angle: f64::NAN,
+        sine,
+        reader_warnings,
+    })
+}
+
+/// Pass 1: the source in chunks, mapped to the workpiece frame in N, spilled and fed on.
+fn first_pass<R: BufRead>(
+    reader: &mut RecordingReader<R>,
+    ch: &Channels,
+    spill: &mut Spill,
+    progress: &mut dyn Progress,
+    sink: &mut signal::ChunkSink<'_>,
+) -> Result<()> {
+    let mut chunk = Chunk::default();
+    let mut out = Chunk {
+        values: vec![Vec::new(); 3],
+        ..Default::default()
+    };
+    let has_z = ch.axes.has(Axis::Z);
+    loop {
+        let n = reader.read_chunk(&mut chunk, ROWS)?;
+        if n == 0 {
+            break;
+        }
+        out.time_s.clone_from(&chunk.time_s); // the spill counts rows by the time column
+        out.values.truncate(3);
+        let [fx, fy, fz] = &mut out.values[..] else {
+            unreachable!("three force columns")
+        };
+        ch.axes.map_chunk(&chunk, Axis::X, fx);
+        ch.axes.map_chunk(&chunk, Axis::Y, fy);
+        if !ch.axes.map_chunk(&chunk, Axis::Z, fz) {
+            fz.clear();
+            fz.resize(n, 0.0);
+        }
+        for (v, f) in [fx, fy, fz].into_iter().zip(&ch.factors) {
+            if *f != 1.0 {
+                v.iter_mut().for_each(|x| *x *= f);
+            }
+        }
+        if let Some(i) = ch.pulse {
+            out.values.push(chunk.channel(i).to_vec());
+        }
+        spill.write(&out)?;
+        sink(as_signal(&out, has_z))?;
+        progress.set_position(reader.bytes_read());
+    }
+    Ok(())
+}
+
+/// A spilled or mapped chunk (fx, fy, fz[, pulse]) as the signal pipeline's chunk.
+fn as_signal(c: &Chunk, has_z: bool) -> signal::Chunk<'_> {
+    signal::Chunk {
+        fx: &c.values[0],
+        fy: &c.values[1],
+        fz: has_z.then_some(&c.values[2][..]),
+        pulse: c.values.get(3).map(|v| &v[..]),
+    }
+}
+
+/// Passes 2 and 3: the spill read back.
+fn replay(
+    spill: &mut Spill,
+    has_z: bool,
+    progress: &mut dyn Progress,
+    sink: &mut signal::ChunkSink<'_>,
+) -> Result<()> {
+    let mut r = spill
+        .reader()
+        .with_context(|| format!("reading temporary file {}", spill.path().display()))?;
+    let mut chunk = Chunk::default();
+    loop {
+        let n = r.read_chunk(&mut chunk)?;
+        if n == 0 {
+            return Ok(());
+        }
+        sink(as_signal(&chunk, has_z))?;
+        progress.advance((n * chunk.values.len() * 8) as u64);
+    }
+}
