@@ -356,7 +356,8 @@ has_verdict!(
     crate::displacement::TeethReport,
     crate::displacement::HeightsReport,
     crate::displacement::SignalReport,
-    crate::shank::ForceReport
+    crate::shank::ForceReport,
+    crate::identify::RecordingsReport
 );
 
 #[cfg(test)]

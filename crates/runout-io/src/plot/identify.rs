@@ -2,7 +2,7 @@
 //! with the fitted sine, and the runout vector with its uncertainty in polar form.
 
 use super::{colour, e2s, PlotError};
-use crate::render_plot;
+use crate::{render_plot, render_svg};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -29,6 +29,47 @@ pub fn waveform_overlay(
     render_plot!(path, (1100, 620), |root: &DrawingArea<_, Shift>| {
         draw_overlay(root, angle_deg, measured, predicted, title)
     })
+}
+
+/// [`waveform_overlay`] as an SVG document in memory.
+pub fn waveform_overlay_svg(
+    angle_deg: &[f64],
+    measured: &[Curve],
+    predicted: &[Curve],
+    title: &str,
+) -> Result<String, PlotError> {
+    render_svg!((1100, 620), |root: &DrawingArea<_, Shift>| {
+        draw_overlay(root, angle_deg, measured, predicted, title)
+    })
+}
+
+/// [`tooth_peak_bars`] as an SVG document in memory.
+pub fn tooth_peak_bars_svg(
+    peaks: &[f64],
+    peak_se: &[f64],
+    mean: f64,
+    amplitude: f64,
+    phase_rad: f64,
+    title: &str,
+) -> Result<String, PlotError> {
+    render_svg!((800, 520), |root: &DrawingArea<_, Shift>| draw_bars(
+        root,
+        peaks,
+        peak_se,
+        (mean, amplitude, phase_rad),
+        title
+    ))
+}
+
+/// [`runout_polar`] as an SVG document in memory.
+pub fn runout_polar_svg(
+    marks: &[RunoutMark],
+    teeth: usize,
+    title: &str,
+) -> Result<String, PlotError> {
+    render_svg!((640, 640), |root: &DrawingArea<_, Shift>| draw_polar(
+        root, marks, teeth, title
+    ))
 }
 
 /// Colour of the predicted trace `i` of [`waveform_overlay`]: [`colour`]`(i)` with each channel

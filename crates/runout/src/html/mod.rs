@@ -17,6 +17,7 @@
 //! Why here and not in its own crate: the page is built from the report types of this crate
 //! and their plots; a separate crate would need all of them public for nothing else.
 
+mod identify;
 mod sections;
 
 use crate::verdict::VerdictReport;

@@ -18,7 +18,7 @@ pub trait ToSection {
     fn section(&self) -> Result<Section>;
 }
 
-fn kv(k: &str, v: impl std::fmt::Display) -> (String, String) {
+pub(super) fn kv(k: &str, v: impl std::fmt::Display) -> (String, String) {
     (k.to_string(), v.to_string())
 }
 
@@ -26,7 +26,7 @@ fn opt(v: Option<f64>, d: usize) -> String {
     v.map_or("–".into(), |v| fmt(v, d))
 }
 
-fn table(caption: &str, head: &[&str], rows: Vec<Vec<Cell>>) -> Table {
+pub(super) fn table(caption: &str, head: &[&str], rows: Vec<Vec<Cell>>) -> Table {
     Table {
         caption: caption.into(),
         head: head.iter().map(|h| h.to_string()).collect(),
@@ -35,7 +35,13 @@ fn table(caption: &str, head: &[&str], rows: Vec<Vec<Cell>>) -> Table {
 }
 
 /// Rows (quantity, value, ± SE) of a result table.
-fn row(name: &str, key: &str, v: f64, se: Option<(&str, Option<f64>)>, d: usize) -> Vec<Cell> {
+pub(super) fn row(
+    name: &str,
+    key: &str,
+    v: f64,
+    se: Option<(&str, Option<f64>)>,
+    d: usize,
+) -> Vec<Cell> {
     vec![
         Cell::text(name),
         Cell::num(key, v, d),
@@ -69,7 +75,7 @@ fn angle_rows(a: &AngleReport, prefix: &str) -> Vec<Vec<Cell>> {
     }
 }
 
-fn verdict_parts(s: &mut Section, v: &Option<VerdictReport>) {
+pub(super) fn verdict_parts(s: &mut Section, v: &Option<VerdictReport>) {
     if let Some(v) = v {
         s.verdict = Some(VerdictView::new(v));
         s.compare = Some(compare_row(v));
