@@ -31,7 +31,9 @@ impl ToSection for RecordingsReport {
                 "cutter",
                 format!(
                     "K = {}, D = {} mm, helix {} deg",
-                    i.teeth, i.diameter_mm, i.helix_deg
+                    i.teeth,
+                    i.diameter_mm,
+                    fmt(i.helix_deg, 2)
                 ),
             ),
             kv("peak component", &i.peak_component),
