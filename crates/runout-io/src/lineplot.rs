@@ -83,6 +83,7 @@ fn draw<DB: DrawingBackend>(
             .map_err(e2s)?;
         chart
             .configure_mesh()
+            .light_line_style(BLACK.mix(0.04))
             .x_desc(x_label)
             .y_desc(panel.y_label.as_str())
             .draw()

@@ -268,6 +268,7 @@ fn draw_forces<DB: DrawingBackend>(
         .map_err(e2s)?;
     chart
         .configure_mesh()
+        .light_line_style(BLACK.mix(0.04))
         .x_desc("spindle angle (deg)")
         .y_desc("force on workpiece (N)")
         .draw()
@@ -291,7 +292,7 @@ fn draw_forces<DB: DrawingBackend>(
     // mark each tooth's peak in every revolution
     let turns = (x1 / 360.0).ceil() as usize;
     for p in peaks.iter().filter(|p| p.angle.is_finite()) {
-        let c = colour(p.tooth + 3);
+        let c = tooth_colour(p.tooth);
         let pts: Vec<(f64, f64)> = (0..turns)
             .map(|t| (p.angle.to_degrees() + 360.0 * t as f64, p.peak_fxy))
             .filter(|(x, _)| *x <= x1)

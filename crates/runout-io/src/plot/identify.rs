@@ -2,9 +2,11 @@
 //! with the fitted sine, and the runout vector with its uncertainty in polar form.
 
 use super::{colour, e2s, PlotError};
+use crate::plot::tooth_colour;
 use crate::{render_plot, render_svg};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 /// One named curve over the spindle angle (deg).
@@ -106,6 +108,7 @@ fn draw_overlay<DB: DrawingBackend>(
         .map_err(e2s)?;
     chart
         .configure_mesh()
+        .light_line_style(BLACK.mix(0.04))
         .x_desc("spindle angle (deg)")
         .y_desc("force (N)")
         .draw()
@@ -189,6 +192,7 @@ fn draw_bars<DB: DrawingBackend>(
         .map_err(e2s)?;
     chart
         .configure_mesh()
+        .light_line_style(BLACK.mix(0.04))
         .x_desc("tooth (cutting order)")
         .y_desc("peak force (N)")
         .x_labels(k)
@@ -329,12 +333,25 @@ fn draw_polar<DB: DrawingBackend>(
                 BLACK.mix(0.35),
             )))
             .map_err(e2s)?;
+        // anchored towards the centre so that no label runs off the plot
+        let h = if end.0 > 0.3 * rmax {
+            HPos::Right
+        } else if end.0 < -0.3 * rmax {
+            HPos::Left
+        } else {
+            HPos::Center
+        };
+        let v = if end.1 > 0.3 * rmax {
+            VPos::Top
+        } else if end.1 < -0.3 * rmax {
+            VPos::Bottom
+        } else {
+            VPos::Center
+        };
+        let mut style = TextStyle::from(("sans-serif", 13).into_font()).pos(Pos::new(h, v));
+        style.color = tooth_colour(i).to_backend_color();
         chart
-            .draw_series(std::iter::once(Text::new(
-                format!("tooth {i}"),
-                end,
-                ("sans-serif", 13),
-            )))
+            .draw_series(std::iter::once(Text::new(format!("tooth {i}"), end, style)))
             .map_err(e2s)?;
     }
     for (q, m) in marks.iter().enumerate() {
