@@ -47,6 +47,8 @@ enum Command {
     Completions(cmd::install::CompletionsArgs),
     /// Man pages generated from this program's options.
     Man(cmd::install::ManArgs),
+    /// Render saved JSON reports as one self-contained HTML page (verdict, comparison table).
+    Report(cmd::report::Args),
 }
 
 /// Status of a command whose standard output was closed early (`runout … | head -1`), as a
@@ -104,6 +106,7 @@ fn main() -> ExitCode {
         }
         Command::Man(a) => cmd::install::man(a, <Cli as clap::CommandFactory>::command()),
         Command::Batch(a) => cmd::batch::run(a),
+        Command::Report(a) => cmd::report::run(a),
     };
     // outputs appear only when the whole command succeeded (or only its stdout was cut short)
     let result = match result {

@@ -37,6 +37,7 @@ pub mod plausibility;
 pub mod runout;
 pub mod shank;
 pub mod signal;
+pub mod verdict;
 
 pub use chip::{ArcChip, ChipAtHeight, ChipThickness, EquivalentChip, ExactChip};
 pub use coefficients::CuttingCoefficients;

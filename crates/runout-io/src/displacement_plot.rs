@@ -1,10 +1,11 @@
 //! Plots of the displacement methods (methods.md §1): polar plot of the per-tooth radii with the
 //! runout vector, and runout vs height with the regression line.
 
-use crate::plot::{colour, draw_legend, e2s, legend_dot, legend_line, PlotError};
-use crate::render_plot;
+use crate::plot::{colour, draw_legend, e2s, legend_dot, legend_line, tooth_colour, PlotError};
+use crate::{render_plot, render_svg};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::f64::consts::TAU;
 use std::path::Path;
 
@@ -35,6 +36,13 @@ pub fn teeth_polar_plot(path: &Path, d: &TeethPlot) -> Result<(), PlotError> {
     ))
 }
 
+/// [`teeth_polar_plot`] as an SVG document in memory.
+pub fn teeth_polar_svg(d: &TeethPlot) -> Result<String, PlotError> {
+    render_svg!((760, 760), |root: &DrawingArea<_, Shift>| draw_teeth(
+        root, d
+    ))
+}
+
 fn draw_teeth<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     d: &TeethPlot,
@@ -57,6 +65,7 @@ fn draw_teeth<DB: DrawingBackend>(
         .map_err(e2s)?;
     chart
         .configure_mesh()
+        .light_line_style(BLACK.mix(0.04))
         .x_desc(format!(
             "spindle frame x (µm; radius = {base:.2} µm + deviation)"
         ))
@@ -84,7 +93,7 @@ fn draw_teeth<DB: DrawingBackend>(
         chart
             .draw_series(LineSeries::new(
                 circle(&|a| base + rho * (a - l).cos()),
-                colour(0).stroke_width(2),
+                BLACK.mix(0.6).stroke_width(2),
             ))
             .map_err(e2s)?
             .label(format!(
@@ -92,7 +101,7 @@ fn draw_teeth<DB: DrawingBackend>(
                 l.to_degrees()
             ))
             .legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], colour(0).stroke_width(2))
+                PathElement::new(vec![(x, y), (x + 18, y)], BLACK.mix(0.6).stroke_width(2))
             });
         let tip = (rho * l.cos(), rho * l.sin());
         chart
@@ -117,29 +126,37 @@ fn draw_teeth<DB: DrawingBackend>(
                 .zip(&d.measured_um)
                 .enumerate()
                 .map(|(i, (a, v))| {
+                    // each tooth in its colour; the label on the side towards the centre, so
+                    // that no label runs off the plot
+                    let right = a.cos() > 0.2;
+                    let mut style = TextStyle::from(("sans-serif", 14).into_font()).pos(Pos::new(
+                        if right { HPos::Right } else { HPos::Left },
+                        VPos::Bottom,
+                    ));
+                    style.color = tooth_colour(i).to_backend_color();
                     EmptyElement::at(pt(*a, *v))
-                        + Circle::new((0, 0), 6, colour(1).filled())
+                        + Circle::new((0, 0), 6, tooth_colour(i).filled())
                         + Text::new(
                             format!("tooth {i}: {v:+.3} µm"),
-                            (8, -14),
-                            ("sans-serif", 14),
+                            (if right { -8 } else { 8 }, -6),
+                            style,
                         )
                 }),
         )
         .map_err(e2s)?
-        .label("measured (tooth tip)")
-        .legend(legend_dot(colour(1)));
+        .label("measured (tooth tip; tooth colours as in every plot)")
+        .legend(legend_dot(tooth_colour(0)));
     if let Some(m) = &d.model_um {
         chart
             .draw_series(
                 d.tooth_angles_rad
                     .iter()
                     .zip(m)
-                    .map(|(a, v)| Cross::new(pt(*a, *v), 7, colour(2).stroke_width(2))),
+                    .map(|(a, v)| Cross::new(pt(*a, *v), 7, BLACK.stroke_width(2))),
             )
             .map_err(e2s)?
             .label("model (exact)")
-            .legend(|(x, y)| Cross::new((x + 9, y), 5, colour(2).stroke_width(2)));
+            .legend(|(x, y)| Cross::new((x + 9, y), 5, BLACK.stroke_width(2)));
     }
     draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
     Ok(())
@@ -166,6 +183,13 @@ pub fn height_plot(path: &Path, d: &HeightPlot) -> Result<(), PlotError> {
     render_plot!(path, (900, 560), |root: &DrawingArea<_, Shift>| {
         draw_heights(root, d)
     })
+}
+
+/// [`height_plot`] as an SVG document in memory.
+pub fn height_svg(d: &HeightPlot) -> Result<String, PlotError> {
+    render_svg!((900, 560), |root: &DrawingArea<_, Shift>| draw_heights(
+        root, d
+    ))
 }
 
 fn draw_heights<DB: DrawingBackend>(
@@ -202,6 +226,7 @@ fn draw_heights<DB: DrawingBackend>(
         .map_err(e2s)?;
     chart
         .configure_mesh()
+        .light_line_style(BLACK.mix(0.04))
         .x_desc("height z (mm)")
         .y_desc("runout r = TIR/2 (µm)")
         .draw()

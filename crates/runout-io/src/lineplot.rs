@@ -2,7 +2,7 @@
 //! such as the shank method's raw signals, deflections and forces.
 
 use crate::plot::{colour, draw_legend, e2s, PlotError};
-use crate::render_plot;
+use crate::{render_plot, render_svg};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -34,6 +34,14 @@ pub fn stacked_plot(
 ) -> Result<(), PlotError> {
     let h = 260 * panels.len().max(1) as u32 + 60;
     render_plot!(path, (1100, h), |root: &DrawingArea<_, Shift>| {
+        draw(root, title, x_label, panels)
+    })
+}
+
+/// [`stacked_plot`] as an SVG document in memory.
+pub fn stacked_svg(title: &str, x_label: &str, panels: &[Panel]) -> Result<String, PlotError> {
+    let h = 260 * panels.len().max(1) as u32 + 60;
+    render_svg!((1100, h), |root: &DrawingArea<_, Shift>| {
         draw(root, title, x_label, panels)
     })
 }
@@ -75,6 +83,7 @@ fn draw<DB: DrawingBackend>(
             .map_err(e2s)?;
         chart
             .configure_mesh()
+            .light_line_style(BLACK.mix(0.04))
             .x_desc(x_label)
             .y_desc(panel.y_label.as_str())
             .draw()

@@ -141,6 +141,30 @@ macro_rules! render_plot {
     }};
 }
 
+/// Render to an SVG document in memory (for reports that inline their plots, e.g. the HTML
+/// report) by calling the same generic drawing function as [`render_plot!`]; evaluates to
+/// `Result<String, PlotError>`.
+#[macro_export]
+macro_rules! render_svg {
+    ($size:expr, $draw:expr) => {{
+        use plotters::prelude::IntoDrawingArea;
+        $crate::plot::ensure_font();
+        let err = |m: String| $crate::plot::PlotError::Draw {
+            path: "(inline svg)".into(),
+            message: m,
+        };
+        let mut buf = String::new();
+        let drawn: Result<(), $crate::plot::PlotError> = {
+            let root =
+                plotters::prelude::SVGBackend::with_string(&mut buf, $size).into_drawing_area();
+            ($draw)(&root)
+                .map_err(err)
+                .and_then(|_| root.present().map_err(|e| err(e.to_string())))
+        };
+        drawn.map(|_| buf)
+    }};
+}
+
 /// A plot can be written to `path`: its folder exists and it is not a folder itself (checked
 /// before drawing, so the message says so rather than the drawing backend's error).
 pub fn check_destination(path: &std::path::Path) -> Result<(), PlotError> {
@@ -240,6 +264,27 @@ pub fn colour(i: usize) -> RGBColor {
     C[i % C.len()]
 }
 
+/// Colour of tooth `i` in every plot and in the HTML report (Okabe–Ito palette, readable for
+/// colour-blind readers and in greyscale print; 7 colours, then repeated).
+pub fn tooth_colour(i: usize) -> RGBColor {
+    const C: [RGBColor; 7] = [
+        RGBColor(0, 114, 178),
+        RGBColor(213, 94, 0),
+        RGBColor(0, 158, 115),
+        RGBColor(204, 121, 167),
+        RGBColor(230, 159, 0),
+        RGBColor(86, 180, 233),
+        RGBColor(120, 94, 60),
+    ];
+    C[i % C.len()]
+}
+
+/// [`tooth_colour`] as CSS `#rrggbb`.
+pub fn tooth_hex(i: usize) -> String {
+    let RGBColor(r, g, b) = tooth_colour(i);
+    format!("#{r:02x}{g:02x}{b:02x}")
+}
+
 /// Forces vs spindle angle (deg) with each tooth's |F_xy| peak marked.
 pub fn force_plot(
     path: &Path,
@@ -276,6 +321,7 @@ fn draw_forces<DB: DrawingBackend>(
         .map_err(e2s)?;
     chart
         .configure_mesh()
+        .light_line_style(BLACK.mix(0.04))
         .x_desc("spindle angle (deg)")
         .y_desc("force on workpiece (N)")
         .draw()
@@ -299,7 +345,7 @@ fn draw_forces<DB: DrawingBackend>(
     // mark each tooth's peak in every revolution
     let turns = (x1 / 360.0).ceil() as usize;
     for p in peaks.iter().filter(|p| p.angle.is_finite()) {
-        let c = colour(p.tooth + 3);
+        let c = tooth_colour(p.tooth);
         let pts: Vec<(f64, f64)> = (0..turns)
             .map(|t| (p.angle.to_degrees() + 360.0 * t as f64, p.peak_fxy))
             .filter(|(x, _)| *x <= x1)

@@ -25,6 +25,7 @@ pub mod case;
 pub mod chip;
 pub mod displacement;
 pub mod grind;
+pub mod html;
 pub mod identify;
 pub mod inspect;
 pub mod job;
@@ -33,6 +34,7 @@ pub mod schema;
 pub mod shank;
 pub mod simulate;
 pub mod spill;
+pub mod verdict;
 
 pub use job::{to_json, NoProgress, Progress, Report, Source};
 pub use runout_core as core;

@@ -49,6 +49,8 @@ pub struct CompareArgs {
     /// Write the JSON result (schema runout.chip.compare/1); `-` for stdout.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    #[command(flatten)]
+    pub report: crate::cmd::report::HtmlFlag,
 }
 
 /// Arguments of `runout chip eval`.
@@ -143,7 +145,8 @@ fn compare(a: CompareArgs) -> Result<()> {
     for w in &report.warnings {
         eprintln!("warning: {w}");
     }
-    check_outputs(&[&a.json], &report.inputs)?;
+    check_outputs(&[&a.json, &a.report.html], &report.inputs)?;
+    a.report.write(&report)?;
     if let Some(j) = &a.json {
         output::write_text(j, &crate::provenance::stamped_json(&report)?)?;
     }

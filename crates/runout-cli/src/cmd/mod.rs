@@ -7,6 +7,7 @@ pub mod grind;
 pub mod identify;
 pub mod inspect;
 pub mod install;
+pub mod report;
 pub mod shank;
 pub mod simulate;
 pub mod simulate_sensor;

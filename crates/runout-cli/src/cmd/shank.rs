@@ -106,6 +106,8 @@ pub struct ForceArgs {
     /// Plot file type: svg or png.
     #[arg(long, default_value = "svg")]
     plot_format: String,
+    #[command(flatten)]
+    report: crate::cmd::report::ReportFlags,
 }
 
 /// Flags of `runout shank calibrate`.
@@ -206,7 +208,8 @@ fn force(a: ForceArgs) -> Result<()> {
         Quantity::FrequencyHz,
     )?;
     req.reparse = a.reparse;
-    for out in [&a.out, &a.json].into_iter().flatten() {
+    let html = a.report.html.clone();
+    for out in [&a.out, &a.json, &html].into_iter().flatten() {
         output::check_not_input(out, &[&a.recording, &a.config])?;
     }
     if a.plot_dir.is_some() {
@@ -225,7 +228,9 @@ fn force(a: ForceArgs) -> Result<()> {
         req.series = Some((p.display().to_string(), format));
         writer = Some(output::create(p)?);
     }
-    let report = shank::force_to(&req, writer, &mut crate::progress::Bars::default())?;
+    let mut report = shank::force_to(&req, writer, &mut crate::progress::Bars::default())?;
+    a.report.judge(&mut report)?;
+    a.report.write(&report)?;
     if let Some(p) = &a.json {
         output::write_text(p, &crate::provenance::stamped_json(&report)?)?;
     }

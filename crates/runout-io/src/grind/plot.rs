@@ -2,7 +2,7 @@
 //! the predicted radial error before / after compensation (SVG or PNG by extension).
 
 use crate::plot::{colour, draw_legend, e2s, PlotError};
-use crate::render_plot;
+use crate::{render_plot, render_svg};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use runout_core::grind::{Compensation, DeviationMap, EdgeLine};
@@ -24,6 +24,13 @@ fn diverging(v: f64) -> RGBColor {
 /// probe point colours the cell reaching halfway to its neighbours (angles wrap).
 pub fn deviation_heatmap(path: &Path, map: &DeviationMap) -> Result<(), PlotError> {
     render_plot!(path, (900, 560), |root: &DrawingArea<_, Shift>| draw_heat(
+        root, map
+    ))
+}
+
+/// [`deviation_heatmap`] as an SVG document in memory.
+pub fn deviation_heatmap_svg(map: &DeviationMap) -> Result<String, PlotError> {
+    render_svg!((900, 560), |root: &DrawingArea<_, Shift>| draw_heat(
         root, map
     ))
 }

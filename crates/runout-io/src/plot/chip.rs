@@ -45,6 +45,7 @@ fn draw_angle<DB: DrawingBackend>(
         .map_err(e2s)?;
     chart
         .configure_mesh()
+        .light_line_style(BLACK.mix(0.04))
         .x_desc("spindle angle (deg)")
         .y_desc("chip thickness h (µm)")
         .draw()
@@ -123,6 +124,7 @@ fn draw_map<DB: DrawingBackend>(
         .map_err(e2s)?;
     chart
         .configure_mesh()
+        .light_line_style(BLACK.mix(0.04))
         .disable_mesh()
         .x_desc("path time (s)")
         .y_desc("height above tool tip z (mm)")
@@ -153,6 +155,7 @@ fn draw_colour_bar<DB: DrawingBackend>(
         .map_err(e2s)?;
     chart
         .configure_mesh()
+        .light_line_style(BLACK.mix(0.04))
         .disable_mesh()
         .disable_x_axis()
         .draw()

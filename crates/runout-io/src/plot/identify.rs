@@ -2,9 +2,11 @@
 //! with the fitted sine, and the runout vector with its uncertainty in polar form.
 
 use super::{colour, draw_legend, e2s, legend_line, PlotError};
-use crate::render_plot;
+use crate::plot::tooth_colour;
+use crate::{render_plot, render_svg};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 /// One named curve over the spindle angle (deg).
@@ -29,6 +31,47 @@ pub fn waveform_overlay(
     render_plot!(path, (1100, 620), |root: &DrawingArea<_, Shift>| {
         draw_overlay(root, angle_deg, measured, predicted, title)
     })
+}
+
+/// [`waveform_overlay`] as an SVG document in memory.
+pub fn waveform_overlay_svg(
+    angle_deg: &[f64],
+    measured: &[Curve],
+    predicted: &[Curve],
+    title: &str,
+) -> Result<String, PlotError> {
+    render_svg!((1100, 620), |root: &DrawingArea<_, Shift>| {
+        draw_overlay(root, angle_deg, measured, predicted, title)
+    })
+}
+
+/// [`tooth_peak_bars`] as an SVG document in memory.
+pub fn tooth_peak_bars_svg(
+    peaks: &[f64],
+    peak_se: &[f64],
+    mean: f64,
+    amplitude: f64,
+    phase_rad: f64,
+    title: &str,
+) -> Result<String, PlotError> {
+    render_svg!((800, 520), |root: &DrawingArea<_, Shift>| draw_bars(
+        root,
+        peaks,
+        peak_se,
+        (mean, amplitude, phase_rad),
+        title
+    ))
+}
+
+/// [`runout_polar`] as an SVG document in memory.
+pub fn runout_polar_svg(
+    marks: &[RunoutMark],
+    teeth: usize,
+    title: &str,
+) -> Result<String, PlotError> {
+    render_svg!((640, 640), |root: &DrawingArea<_, Shift>| draw_polar(
+        root, marks, teeth, title
+    ))
 }
 
 /// Colour of the predicted trace `i` of [`waveform_overlay`]: [`colour`]`(i)` with each channel
@@ -65,6 +108,7 @@ fn draw_overlay<DB: DrawingBackend>(
         .map_err(e2s)?;
     chart
         .configure_mesh()
+        .light_line_style(BLACK.mix(0.04))
         .x_desc("spindle angle (deg)")
         .y_desc("force (N)")
         .draw()
@@ -142,6 +186,7 @@ fn draw_bars<DB: DrawingBackend>(
         .map_err(e2s)?;
     chart
         .configure_mesh()
+        .light_line_style(BLACK.mix(0.04))
         .x_desc("tooth (cutting order)")
         .y_desc("peak force (N)")
         .x_labels(k)
@@ -270,12 +315,25 @@ fn draw_polar<DB: DrawingBackend>(
                 BLACK.mix(0.35),
             )))
             .map_err(e2s)?;
+        // anchored towards the centre so that no label runs off the plot
+        let h = if end.0 > 0.3 * rmax {
+            HPos::Right
+        } else if end.0 < -0.3 * rmax {
+            HPos::Left
+        } else {
+            HPos::Center
+        };
+        let v = if end.1 > 0.3 * rmax {
+            VPos::Top
+        } else if end.1 < -0.3 * rmax {
+            VPos::Bottom
+        } else {
+            VPos::Center
+        };
+        let mut style = TextStyle::from(("sans-serif", 13).into_font()).pos(Pos::new(h, v));
+        style.color = tooth_colour(i).to_backend_color();
         chart
-            .draw_series(std::iter::once(Text::new(
-                format!("tooth {i}"),
-                end,
-                ("sans-serif", 13),
-            )))
+            .draw_series(std::iter::once(Text::new(format!("tooth {i}"), end, style)))
             .map_err(e2s)?;
     }
     for (q, m) in marks.iter().enumerate() {

@@ -11,7 +11,7 @@ use runout_core::chip::compare::{
 use runout_core::chip::{calibration_grid, fit_compensation, CompensationFit, EquivalentParams};
 use runout_io::config::chip::ChipCase;
 use schemars::JsonSchema;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -29,7 +29,7 @@ pub struct CompareRequest {
 }
 
 /// Error metrics of one model against the exact IUCT.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct Metrics {
     pub mean_relative_error_percent: f64,
     pub normalised_mae_percent: f64,
@@ -49,7 +49,7 @@ impl From<&ErrorMetrics> for Metrics {
 }
 
 /// Errors per model.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct ModelErrors {
     pub arc: Metrics,
     pub circle: Metrics,
@@ -83,7 +83,7 @@ impl ModelErrors {
 }
 
 /// Points per second (wall time, one thread).
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct Throughput {
     pub exact: f64,
     pub equivalent: f64,
@@ -91,7 +91,7 @@ pub struct Throughput {
 }
 
 /// Throughput of all cases pooled.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct PooledThroughput {
     pub exact: f64,
     pub equivalent: f64,
@@ -100,7 +100,7 @@ pub struct PooledThroughput {
 }
 
 /// (k₁, k₂) fitted on calibration angles.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct FittedK {
     pub k1: f64,
     pub k2: f64,
@@ -112,7 +112,7 @@ pub struct FittedK {
 }
 
 /// One case.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct CaseReport {
     pub name: String,
     pub points: usize,
@@ -122,14 +122,14 @@ pub struct CaseReport {
 }
 
 /// What the metrics mean.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct MetricsDefinitions {
     pub mean_relative_error: String,
     pub normalised_mae: String,
 }
 
 /// The equivalent model's parameters.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct EquivalentModel {
     pub k1: f64,
     pub k2: f64,
@@ -137,7 +137,7 @@ pub struct EquivalentModel {
 }
 
 /// `runout.chip.compare/1`.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct CompareReport {
     /// `runout.chip.compare/1`
     #[schemars(extend("const" = "runout.chip.compare/1"))]

@@ -3,13 +3,14 @@
 
 use super::{name_of, AngleReport};
 use crate::job::{Report, Source};
+use crate::verdict::{AxisReport, VerdictBasis, VerdictReport};
 use anyhow::{Context, Result};
 use runout_core::displacement::{
     runout_at_height, vector_at_height, HeightFit, HeightRegression, VectorHeightFit,
 };
 use runout_io::displacement::read_height_table;
 use schemars::JsonSchema;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// `runout displacement heights`.
 #[derive(Debug, Clone)]
@@ -22,14 +23,14 @@ pub struct HeightsRequest {
 }
 
 /// The input as reported.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct HeightsInput {
     pub file: String,
     pub points: usize,
 }
 
 /// The offset + tilt vector fit (§1.6).
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct VectorReport {
     pub offset_um: f64,
     pub offset_se_um: Option<f64>,
@@ -41,7 +42,7 @@ pub struct VectorReport {
 }
 
 /// `runout.displacement.heights/1`.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct HeightsReport {
     /// `runout.displacement.heights/1`
     #[schemars(extend("const" = "runout.displacement.heights/1"))]
@@ -57,6 +58,9 @@ pub struct HeightsReport {
     pub residual_rms_um: f64,
     pub notes: Vec<String>,
     pub vector: Option<VectorReport>,
+    /// Pass/fail against the runout tolerance, and the runout at the cutting height against the
+    /// highest reading (tilt) (issue 15).
+    pub verdict: Option<VerdictReport>,
     /// The core results behind the text and the plot; not part of the JSON.
     #[serde(skip)]
     #[schemars(skip)]
@@ -94,6 +98,47 @@ pub fn heights(req: &HeightsRequest) -> Result<HeightsReport> {
         .map(|p| vector_at_height(&p, at))
         .transpose()
         .with_context(|| file.clone())?;
+    // tip (the cutting height) against the highest reading: vectors with the angle column,
+    // else the magnitudes of the regression
+    let z_top = pts.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max);
+    let axis = if z_top > at {
+        let (tip, top) = match &vector {
+            Some(v) => {
+                let e = |z: f64| {
+                    let x = v.offset_at_zero_mm[0] + z * v.tilt[0];
+                    let y = v.offset_at_zero_mm[1] + z * v.tilt[1];
+                    (x.hypot(y) * 1e3, y.atan2(x).to_degrees())
+                };
+                (e(at), e(z_top))
+            }
+            None => ((fit.at(at) * 1e3, 0.0), (fit.at(z_top) * 1e3, 0.0)),
+        };
+        Some(AxisReport::from_polar(
+            tip,
+            top,
+            z_top - at,
+            "highest reading",
+        )?)
+    } else {
+        None
+    };
+    let verdict = VerdictReport::new(
+        VerdictBasis {
+            offset_um: fit.offset_mm * 1e3,
+            offset_se_um: fit.offset_se_mm.map(|s| s * 1e3),
+            angle_deg: vector
+                .as_ref()
+                .and_then(|v| v.angle.angle())
+                .map(f64::to_degrees),
+            teeth: None,
+            diameter_mm: None,
+            helix_deg: 0.0,
+            height_mm: fit.height_mm,
+            fz_mm: None,
+        },
+        None,
+    )?
+    .with_axis(axis);
     Ok(HeightsReport {
         schema: HeightsReport::SCHEMA.into(),
         input: HeightsInput {
@@ -117,6 +162,7 @@ pub fn heights(req: &HeightsRequest) -> Result<HeightsReport> {
             residual_rms_um: v.residual_rms_mm * 1e3,
             angle: AngleReport::from(&v.angle),
         }),
+        verdict: Some(verdict),
         detail: HeightsDetail {
             points: pts,
             fit: Some(fit),

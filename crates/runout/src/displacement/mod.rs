@@ -17,7 +17,7 @@ pub use teeth::{teeth, TeethDetail, TeethInput, TeethReport, TeethRequest};
 
 use runout_core::displacement::{AngleEstimate, BeamGeometry, Consequences, SensorSign};
 use schemars::JsonSchema;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The serialised name of a core enum (`"joint"`, `"pulse"`, …).
 fn name_of<T: Serialize>(t: &T) -> String {
@@ -36,7 +36,7 @@ pub struct Sensor {
 }
 
 /// The sensor as reported.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct BeamReport {
     pub sensor: String,
     pub inclination_deg: f64,
@@ -55,7 +55,7 @@ impl From<&Sensor> for BeamReport {
 
 /// An angle estimate (degrees), flattened into its report: `angle_status` is `determined`,
 /// `ambiguous` (two candidates) or `undetermined` (with the reason).
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct AngleReport {
     pub angle_status: String,
     pub angle_deg: Option<f64>,
@@ -110,7 +110,7 @@ impl From<&AngleEstimate> for AngleReport {
 }
 
 /// Predicted consequences (§1.7).
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct ConsequencesReport {
     pub height_mm: f64,
     pub tooth_radii_mm: Vec<f64>,

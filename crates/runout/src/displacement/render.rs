@@ -1,6 +1,7 @@
 //! The displacement reports as text (what the CLI prints) and plots.
 
 use super::{HeightsReport, SignalReport, TeethReport};
+use crate::verdict::verdict_text;
 use anyhow::{Context, Result};
 use runout_core::displacement::{AngleEstimate, Consequences};
 use runout_io::displacement_plot::{height_plot, teeth_polar_plot, HeightPlot, TeethPlot};
@@ -96,7 +97,8 @@ pub fn teeth_text(r: &TeethReport) -> String {
     if let Some(c) = &r.detail.consequences {
         s += &consequences_text(c);
     }
-    s + &notes_text(&fit.notes)
+    s += &notes_text(&fit.notes);
+    s + &r.verdict.as_ref().map_or(String::new(), verdict_text)
 }
 
 /// `displacement teeth` polar plot.
@@ -167,7 +169,8 @@ pub fn heights_text(r: &HeightsReport) -> String {
             v.tilt[1] * 1e3
         );
     }
-    s + &notes_text(&fit.notes)
+    s += &notes_text(&fit.notes);
+    s + &r.verdict.as_ref().map_or(String::new(), verdict_text)
 }
 
 /// `displacement heights` plot: points, regression line, result with its ±2σ bar.
@@ -247,7 +250,7 @@ pub fn signal_text(r: &SignalReport) -> String {
             s += &consequences_text(c);
         }
     }
-    s
+    s + &r.verdict.as_ref().map_or(String::new(), verdict_text)
 }
 
 /// `displacement signal` polar plot.

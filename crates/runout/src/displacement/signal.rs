@@ -3,6 +3,7 @@
 
 use super::{name_of, AngleReport, BeamReport, ConsequencesReport, Sensor};
 use crate::job::{Report, Source};
+use crate::verdict::{VerdictBasis, VerdictReport};
 use anyhow::{bail, Context, Result};
 use runout_core::displacement::{
     consequences, fit_signal, identify_from_teeth, per_revolution_runout, per_tooth_extrema,
@@ -13,7 +14,7 @@ use runout_core::Cutter;
 use runout_io::displacement::{read_signal, SignalSection};
 use runout_io::displacement_plot::TeethPlot;
 use schemars::JsonSchema;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Which spindle angle source to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -52,14 +53,14 @@ pub struct SignalRequest {
 }
 
 /// The input as reported.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct SignalInputReport {
     pub file: String,
     pub channels: Vec<String>,
 }
 
 /// One channel's own fit.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct ChannelReport {
     pub channel: String,
     pub sensor_angle_deg: f64,
@@ -69,7 +70,7 @@ pub struct ChannelReport {
 }
 
 /// The section analysed.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct SectionReport {
     pub from_s: f64,
     pub to_s: f64,
@@ -77,7 +78,7 @@ pub struct SectionReport {
 }
 
 /// TIR/2 per revolution of one channel (seed eq. 5).
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct PerRevolution {
     pub channel: String,
     pub half_tir_mean_um: f64,
@@ -85,7 +86,7 @@ pub struct PerRevolution {
 }
 
 /// The per-tooth extrema fit (channel 0).
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct SignalTeeth {
     pub offset_um: f64,
     pub offset_se_um: Option<f64>,
@@ -98,7 +99,7 @@ pub struct SignalTeeth {
 }
 
 /// `runout.displacement.signal/1`.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct SignalReport {
     /// `runout.displacement.signal/1`
     #[schemars(extend("const" = "runout.displacement.signal/1"))]
@@ -122,6 +123,8 @@ pub struct SignalReport {
     pub per_revolution: Vec<PerRevolution>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub teeth: Option<SignalTeeth>,
+    /// Pass/fail against the runout tolerance and the consequences for the cut (issue 15).
+    pub verdict: Option<VerdictReport>,
     /// The core results behind the text and the plot; not part of the JSON.
     #[serde(skip)]
     #[schemars(skip)]
@@ -237,6 +240,19 @@ pub fn signal(req: &SignalRequest) -> Result<SignalReport> {
         teeth = Some((tf, cons));
     }
     let names = &table.channels;
+    let verdict = VerdictReport::new(
+        VerdictBasis {
+            offset_um: fit.offset_mm * 1e3,
+            offset_se_um: Some(fit.offset_se_mm * 1e3),
+            angle_deg: fit.angle.angle().map(f64::to_degrees),
+            teeth: req.cutter.as_ref().map(Cutter::teeth),
+            diameter_mm: req.cutter.as_ref().map(Cutter::diameter),
+            helix_deg: req.cutter.as_ref().map_or(0.0, |c| c.helix().to_degrees()),
+            height_mm: req.height_mm,
+            fz_mm: req.fz_mm,
+        },
+        None,
+    )?;
     Ok(SignalReport {
         schema: SignalReport::SCHEMA.into(),
         input: SignalInputReport {
@@ -289,6 +305,7 @@ pub fn signal(req: &SignalRequest) -> Result<SignalReport> {
             angle: AngleReport::from(&tf.angle),
             consequences: cons.as_ref().map(ConsequencesReport::from),
         }),
+        verdict: Some(verdict),
         detail: SignalDetail {
             fit: Some(fit),
             sample_rate_hz: table.sample_rate_hz,

@@ -2,6 +2,7 @@
 
 use super::{name_of, AngleReport, BeamReport, ConsequencesReport, Sensor};
 use crate::job::{Report, Source};
+use crate::verdict::{VerdictBasis, VerdictReport};
 use anyhow::{Context, Result};
 use runout_core::displacement::{
     consequences, identify_from_teeth, Consequences, SensorSign, ToothFit, ToothFitOptions,
@@ -9,7 +10,7 @@ use runout_core::displacement::{
 };
 use runout_io::displacement::read_tooth_table;
 use schemars::JsonSchema;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// `runout displacement teeth`: the readings table and the fit options (cutter, height,
 /// method, known offset, noise, beam, phase hint inside `options`).
@@ -27,7 +28,7 @@ pub struct TeethRequest {
 }
 
 /// The inputs as reported.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct TeethInput {
     pub file: String,
     pub tooth_numbering: String,
@@ -43,7 +44,7 @@ pub struct TeethInput {
 }
 
 /// `runout.displacement.teeth/1`.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct TeethReport {
     /// `runout.displacement.teeth/1`
     #[schemars(extend("const" = "runout.displacement.teeth/1"))]
@@ -62,6 +63,8 @@ pub struct TeethReport {
     pub beam_factor: f64,
     pub notes: Vec<String>,
     pub consequences: Option<ConsequencesReport>,
+    /// Pass/fail against the runout tolerance and the consequences for the cut (issue 15).
+    pub verdict: Option<VerdictReport>,
     #[serde(flatten)]
     pub angle: AngleReport,
     /// The core results behind the text and the plot; not part of the JSON.
@@ -140,6 +143,19 @@ pub fn teeth(req: &TeethRequest) -> Result<TeethReport> {
         beam_factor: fit.beam_factor,
         notes: fit.notes.clone(),
         consequences: cons.as_ref().map(ConsequencesReport::from),
+        verdict: Some(VerdictReport::new(
+            VerdictBasis {
+                offset_um: fit.offset_mm * 1e3,
+                offset_se_um: fit.offset_se_mm.map(|x| x * 1e3),
+                angle_deg: fit.angle.angle().map(f64::to_degrees),
+                teeth: Some(k),
+                diameter_mm: Some(cutter.diameter()),
+                helix_deg: cutter.helix().to_degrees(),
+                height_mm: opts.height_mm,
+                fz_mm: req.fz_mm,
+            },
+            None,
+        )?),
         angle: AngleReport::from(&fit.angle),
         detail: TeethDetail {
             fit: Some(fit),

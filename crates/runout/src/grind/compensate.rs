@@ -9,7 +9,7 @@ use runout_core::angle::wrap_deg180;
 use runout_core::grind::*;
 use runout_io::gcode::{NcProgram, RewriteOptions};
 use schemars::JsonSchema;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Sense of the probe table's `angle_deg`, seen from the shank looking at the tip.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -67,7 +67,7 @@ pub struct CompensateRequest {
 }
 
 /// The inputs as reported.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct InputsReport {
     pub probe: String,
     pub edge: String,
@@ -81,7 +81,7 @@ pub struct InputsReport {
 }
 
 /// The probe grid.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct GridReport {
     pub layers: usize,
     pub u_range_mm: [f64; 2],
@@ -89,7 +89,7 @@ pub struct GridReport {
 }
 
 /// One probed layer.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct LayerReport {
     pub u_mm: f64,
     pub angles: usize,
@@ -103,7 +103,7 @@ pub struct LayerReport {
 }
 
 /// The fitted bar axis.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct AxisReport {
     pub offset_at_u0_um: [f64; 2],
     pub offset_um: f64,
@@ -117,7 +117,7 @@ pub struct AxisReport {
 }
 
 /// The compensation along the edge.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct CompensationReport {
     pub points: usize,
     pub outside_probed_range: usize,
@@ -133,7 +133,7 @@ pub struct CompensationReport {
 }
 
 /// The NC rewrite.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct NcReport {
     pub output: String,
     pub linear_moves: usize,
@@ -143,7 +143,7 @@ pub struct NcReport {
 }
 
 /// `runout.grind.compensate/1`.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct CompensateReport {
     /// `runout.grind.compensate/1`
     #[schemars(extend("const" = "runout.grind.compensate/1"))]

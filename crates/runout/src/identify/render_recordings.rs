@@ -78,6 +78,9 @@ pub fn recordings_text(r: &RecordingsReport) -> String {
             let _ = writeln!(s, "full-signal fit: failed: {error}");
         }
     }
+    if let Some(v) = &r.verdict {
+        s += &crate::verdict::verdict_text(v);
+    }
     s
 }
 

@@ -5,13 +5,14 @@
 use super::config::{load_config, open, plan, Reader, Resolved};
 use crate::job::{Progress, Report, Source};
 use crate::spill::{Spill, SpillReader};
+use crate::verdict::{AxisReport, VerdictBasis, VerdictReport};
 use anyhow::{Context, Result};
 use runout_core::shank::{
     analyse, ComparisonMetrics, OutputBlock, PairAxis, Reconstructor, ShankAnalysis, Survey,
 };
 use runout_io::recording::{BinaryLayout, BinaryWriter, CsvWriter, RecordingChunk, RecordingInfo};
 use schemars::JsonSchema;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::io::Write;
 
 /// `runout shank force`: the recording, its shank.toml, and options.
@@ -53,7 +54,7 @@ pub enum SeriesFormat {
 }
 
 /// A sensor pair as configured.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct PairReport {
     pub axis: String,
     pub sensor_I: String,
@@ -62,7 +63,7 @@ pub struct PairReport {
 }
 
 /// The beam used.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct BeamReport {
     pub modulus_gpa: f64,
     pub diameter_mm: f64,
@@ -73,7 +74,7 @@ pub struct BeamReport {
 }
 
 /// Spindle speed measured.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct SpindleReport {
     pub source: String,
     pub rpm: f64,
@@ -82,7 +83,7 @@ pub struct SpindleReport {
 }
 
 /// Runout at one sensor height.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct SensorRunout {
     pub height_above_tip_mm: f64,
     pub runout_um: f64,
@@ -90,7 +91,7 @@ pub struct SensorRunout {
 }
 
 /// Runout offset + tilt from the air cuts.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct RunoutReport {
     pub offset_um: f64,
     pub offset_se_um: f64,
@@ -106,7 +107,7 @@ pub struct RunoutReport {
 }
 
 /// Force statistics of one axis over the cut.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct AxisForce {
     pub axis: String,
     pub mean_N: f64,
@@ -116,7 +117,7 @@ pub struct AxisForce {
 }
 
 /// Shank force against the reference channel of one axis.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct AxisValidation {
     pub axis: String,
     pub samples: u64,
@@ -129,14 +130,14 @@ pub struct AxisValidation {
 }
 
 /// Validation against a reference force (a dynamometer in the same recording).
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct Validation {
     pub reference_axes: Option<String>,
     pub per_axis: Vec<AxisValidation>,
 }
 
 /// The dynamic correction applied.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct Correction {
     pub source: String,
     pub deconvolution_floor: f64,
@@ -144,14 +145,14 @@ pub struct Correction {
 }
 
 /// A tooth-passing harmonic beyond the usable band.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct ToothHarmonic {
     pub harmonic: usize,
     pub frequency_hz: f64,
 }
 
 /// A resonance seen in the cut's spectrum.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct SpectralResonance {
     pub frequency_hz: f64,
     pub damping: Option<f64>,
@@ -162,7 +163,7 @@ pub struct SpectralResonance {
 }
 
 /// Bending mode, usable bandwidth and correction (issue 11 item 7).
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct Dynamics {
     pub first_bending_mode_hz: f64,
     pub first_bending_mode_source: String,
@@ -181,14 +182,14 @@ pub struct Dynamics {
 }
 
 /// The time series written.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct OutputReport {
     pub path: String,
     pub columns: Vec<String>,
 }
 
 /// `runout.shank.force/1`: force, deflections and runout from a shank recording.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct ForceReport {
     /// `runout.shank.force/1`
     #[schemars(extend("const" = "runout.shank.force/1"))]
@@ -215,6 +216,9 @@ pub struct ForceReport {
     pub lowpass_hz: Option<f64>,
     pub output: Option<OutputReport>,
     pub warnings: Vec<String>,
+    /// Pass/fail against the runout tolerance at the cutting height, the consequences for the
+    /// cut, and the runout at the tip against the gauge line (issue 15).
+    pub verdict: Option<VerdictReport>,
     /// What the plots show (thinned, bounded): not part of the JSON.
     #[serde(skip)]
     #[schemars(skip)]
@@ -623,7 +627,7 @@ fn summary(
         "from an arbitrary spindle-angle origin (theta = 0 at the first sample; no pulse channel): only magnitudes and the offset-to-tilt angle are meaningful"
     };
     let letter = |a: PairAxis| a.letter().to_string();
-    ForceReport {
+    let mut report = ForceReport {
         schema: ForceReport::SCHEMA.into(),
         recording: info.file.clone(),
         format: format!("{:?}", info.format),
@@ -727,8 +731,52 @@ fn summary(
             columns,
         }),
         warnings,
+        verdict: None,
         plot: ForcePlotData::default(),
+    };
+    match verdict_of(&report, s.has_pulse) {
+        Ok(v) => report.verdict = Some(v),
+        Err(e) => report.warnings.push(format!("no verdict: {e:#}")),
     }
+    report
+}
+
+/// The verdict at the cutting height (issue 15): the cutter is the shank's diameter with the
+/// `[shank] teeth` of the config (no feed in a shank config: radii, no chips); the angle only with
+/// a pulse mark (else the teeth cannot be told apart); tip against the gauge line (holder face,
+/// `tool_length_mm` above the tip) from the offset + tilt fit.
+fn verdict_of(r: &ForceReport, has_pulse: bool) -> Result<VerdictReport> {
+    let ro = &r.runout;
+    let v = VerdictReport::new(
+        VerdictBasis {
+            offset_um: ro.offset_um,
+            offset_se_um: Some(ro.offset_se_um),
+            angle_deg: has_pulse.then_some(ro.angle_deg),
+            teeth: r.dynamics.teeth,
+            diameter_mm: Some(r.beam.diameter_mm),
+            helix_deg: 0.0,
+            height_mm: ro.at_height_above_tip_mm,
+            fz_mm: None,
+        },
+        None,
+    )?;
+    let l = r.beam.tool_length_mm;
+    let (tx, ty) = {
+        let a = ro.tip_angle_deg.to_radians();
+        (ro.tip_offset_um * a.cos(), ro.tip_offset_um * a.sin())
+    };
+    let ta = ro.tilt_angle_deg.to_radians();
+    let (gx, gy) = (
+        tx + l * ro.tilt_um_per_mm * ta.cos(),
+        ty + l * ro.tilt_um_per_mm * ta.sin(),
+    );
+    let axis = AxisReport::from_polar(
+        (ro.tip_offset_um, ro.tip_angle_deg),
+        (gx.hypot(gy), gy.atan2(gx).to_degrees()),
+        l,
+        "gauge line (holder face)",
+    )?;
+    Ok(v.with_axis(Some(axis)))
 }
 
 /// The bending mode, usable bandwidth and correction (issue 11 item 7).

@@ -139,6 +139,9 @@ pub fn force_text(j_: &ForceReport) -> String {
     for w in &j_.warnings {
         let _ = writeln!(s, "warning: {w}");
     }
+    if let Some(v) = &j_.verdict {
+        s += &crate::verdict::verdict_text(v);
+    }
     s
 }
 

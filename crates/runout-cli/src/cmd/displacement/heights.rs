@@ -41,11 +41,12 @@ pub fn run(a: Args) -> Result<()> {
         Some(MethodArg::Eq6) => HeightRegression::SeedEq6,
     };
     let plot = a.out.check(&a.table, "heights")?;
-    let report = heights(&HeightsRequest {
+    let mut report = heights(&HeightsRequest {
         table: Source::path(&a.table),
         at_mm,
         method,
     })?;
+    a.out.report.judge(&mut report)?;
     if let Some(p) = &plot {
         a.out.plots.create_dir()?;
         render::heights_plot(p, &report)?;

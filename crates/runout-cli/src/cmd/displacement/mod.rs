@@ -54,18 +54,25 @@ pub struct OutputFlags {
     /// Plot (`teeth`, `heights` or `signal`.<format>).
     #[command(flatten)]
     pub plots: crate::flags::PlotFlags,
+    #[command(flatten)]
+    pub report: crate::cmd::report::ReportFlags,
 }
 
 impl OutputFlags {
     /// Refuse outputs that overwrite `input`; the plot file of `kind`.
     pub fn check(&self, input: &Path, kind: &str) -> Result<Option<PathBuf>> {
         let plot = self.plots.file(kind);
-        crate::flags::check_outputs([&self.json, &self.text, &plot], &[input])?;
+        crate::flags::check_outputs([&self.json, &self.text, &plot, &self.report.html], &[input])?;
         Ok(plot)
     }
 
     /// Write JSON and text (text to stdout unless the JSON goes there).
-    pub fn write<R: runout::Report>(&self, report: &R, text: &str) -> Result<()> {
+    pub fn write<R: runout::Report + runout::html::ToSection>(
+        &self,
+        report: &R,
+        text: &str,
+    ) -> Result<()> {
+        self.report.write(report)?;
         if let Some(j) = &self.json {
             crate::output::write_text(j, &crate::provenance::stamped_json(report)?)?;
         }

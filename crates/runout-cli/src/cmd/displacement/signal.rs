@@ -113,7 +113,8 @@ pub fn run(a: Args) -> Result<()> {
         hole_path_mm,
     };
     let plot = a.out.check(&a.recording, "signal")?;
-    let report = signal(&req)?;
+    let mut report = signal(&req)?;
+    a.out.report.judge(&mut report)?;
     if let Some(p) = &plot {
         a.out.plots.create_dir()?;
         render::signal_plot(p, &report)?;

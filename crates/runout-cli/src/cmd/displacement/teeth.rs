@@ -68,13 +68,14 @@ pub fn run(a: Args) -> Result<()> {
         quantity("phase-deg", &a.phase_deg, Quantity::AngleDeg)?.map(f64::to_radians);
     let (fz_mm, hole_path_mm) = a.cutter.fz_and_hole()?;
     let plot = a.out.check(&a.readings, "teeth")?;
-    let report = teeth(&TeethRequest {
+    let mut report = teeth(&TeethRequest {
         readings: Source::path(&a.readings),
         options: opts,
         sign,
         fz_mm,
         hole_path_mm,
     })?;
+    a.out.report.judge(&mut report)?;
     if let Some(p) = &plot {
         a.out.plots.create_dir()?;
         render::teeth_plot(p, &report)?;

@@ -79,6 +79,8 @@ pub struct CompensateArgs {
     /// Plot format: svg | png.
     #[arg(long, default_value = "svg")]
     pub plot_format: String,
+    #[command(flatten)]
+    pub report: crate::cmd::report::HtmlFlag,
 }
 
 fn options(a: &CompensateArgs) -> Result<ProbeOptions> {
@@ -172,7 +174,10 @@ pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
         inputs.push(&edge_path);
     }
     inputs.extend(a.nc.as_deref());
-    for out in [&a.out, &a.path_out, &a.json].into_iter().flatten() {
+    for out in [&a.out, &a.path_out, &a.json, &a.report.html]
+        .into_iter()
+        .flatten()
+    {
         output::check_not_input(out, &inputs)?;
         if a.nc.as_deref().is_some_and(|n| output::same_file(out, n)) {
             bail!(
@@ -223,6 +228,7 @@ pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
     if let (Some(dir), Some(f)) = (&a.plot_dir, plot_format) {
         render::compensate_plots(dir, f.ext(), &report)?;
     }
+    a.report.write(&report)?;
     if let Some(j) = &a.json {
         output::write_text(j, &crate::provenance::stamped_json(&report)?)?;
     }

@@ -105,6 +105,8 @@ pub struct RecordingArgs {
     /// Plot format: svg | png.
     #[arg(long, default_value = "svg")]
     pub plot_format: String,
+    #[command(flatten)]
+    pub report: crate::cmd::report::ReportFlags,
 }
 
 impl RecordingArgs {
@@ -159,6 +161,9 @@ pub fn run(a: RecordingArgs) -> Result<()> {
     if let Some(c) = &a.config {
         inputs.push(c);
     }
+    if let Some(h) = &a.report.html {
+        output::check_not_input(h, &inputs)?;
+    }
     if let Some(j) = &a.json {
         output::check_not_input(j, &inputs)?;
     }
@@ -166,7 +171,9 @@ pub fn run(a: RecordingArgs) -> Result<()> {
         "svg" | "png" => a.plot_format.as_str(),
         other => bail!("--plot-format: expected svg or png, got `{other}`"),
     };
-    let report = identify::recordings(&req, &mut crate::progress::Bars::default())?;
+    let mut report = identify::recordings(&req, &mut crate::progress::Bars::default())?;
+    a.report.judge(&mut report)?;
+    a.report.write(&report)?;
     super::emit(a.json.as_deref(), &report, || recordings_text(&report))?;
     if let Some(dir) = &a.plot_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;

@@ -258,6 +258,9 @@ pub struct RecordingsReport {
     pub status: Verdicts,
     pub fitted_radius_difference_um: Option<f64>,
     pub radius_difference_warnings: Vec<String>,
+    /// Pass/fail of the full-signal runout against the tolerance and its consequences for the
+    /// cut at the largest f_z of the recordings (issue 15).
+    pub verdict: Option<crate::verdict::VerdictReport>,
     /// Per recording, the waveforms for plots.
     #[serde(skip)]
     #[schemars(skip)]
@@ -450,7 +453,7 @@ pub(super) fn build(
     extra: &Extra,
 ) -> RecordingsReport {
     let c = &req.cutter;
-    RecordingsReport {
+    let mut report = RecordingsReport {
         schema: RecordingsReport::SCHEMA.into(),
         conventions: "angles from tooth 0 in the direction of rotation; forces on the workpiece; tooth 0 is absolute only with a pulse channel and tooth0_angle_deg, otherwise the first tooth period of the average".into(),
         inputs: inputs(req, files),
@@ -482,6 +485,35 @@ pub(super) fn build(
             .as_ref()
             .map(|f| radius_difference_warnings(c, files, f))
             .unwrap_or_default(),
+        verdict: None,
         waveforms: files.iter().map(|f| waveform(req, f, fit, extra)).collect(),
-    }
+    };
+    report.verdict = verdict_of(&report);
+    report
+}
+
+/// The verdict on the full-signal runout (issue 15), at the tip, for the cutter of the inputs
+/// (flat with its helix; a profiled cutter is judged by its nominal diameter) and the largest
+/// f_z of the recordings; none without a full-signal fit.
+fn verdict_of(r: &RecordingsReport) -> Option<crate::verdict::VerdictReport> {
+    let f = r.full_signal.ok()?;
+    let fz = r
+        .recordings
+        .iter()
+        .map(|x| x.fz_mm)
+        .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))));
+    crate::verdict::VerdictReport::new(
+        crate::verdict::VerdictBasis {
+            offset_um: f.offset_um,
+            offset_se_um: f.offset_um_se,
+            angle_deg: Some(f.angle_deg),
+            teeth: Some(r.inputs.teeth),
+            diameter_mm: Some(r.inputs.diameter_mm),
+            helix_deg: r.inputs.helix_deg,
+            height_mm: 0.0,
+            fz_mm: fz,
+        },
+        None,
+    )
+    .ok()
 }
