@@ -75,3 +75,13 @@ pub fn closed_pipe<S: AsRef<std::ffi::OsStr> + std::fmt::Debug>(args: &[S]) {
         "{args:?}: {err}"
     );
 }
+
+/// A JSON report as text without its `provenance` (the last field; command line, input names
+/// and time differ between two runs that must otherwise agree). Text that has none is returned
+/// as it is.
+pub fn without_provenance(text: &str) -> String {
+    match text.find(",\n  \"provenance\": {") {
+        Some(i) => text[..i].to_string() + "\n}\n",
+        None => text.to_string(),
+    }
+}
