@@ -475,7 +475,7 @@ mod tests {
             helix in 0.0f64..45.0,
             zf in 0.0f64..1.0,
         ) {
-            let cutter = Cutter::flat(d, k, helix).unwrap();
+            let cutter = Cutter::flat(d, k, helix.to_radians()).unwrap();
             let v = verdict(&VerdictInput {
                 runout: Runout::new(rho_um * 1e-3, lambda.to_radians()).unwrap(),
                 offset_se_mm: Some(0.1e-3),

@@ -144,7 +144,7 @@ impl VerdictReport {
     /// default for the diameter, [`runout_core::verdict::default_tolerance_tir_mm`]).
     pub fn new(basis: VerdictBasis, tolerance_tir_um: Option<f64>) -> Result<Self> {
         let cutter = match (basis.teeth, basis.diameter_mm, basis.angle_deg) {
-            (Some(k), Some(d), Some(_)) => Some(Cutter::flat(d, k, basis.helix_deg)?),
+            (Some(k), Some(d), Some(_)) => Some(Cutter::flat(d, k, basis.helix_deg.to_radians())?),
             _ => None,
         };
         let rho = basis.offset_um.max(0.0) * 1e-3;

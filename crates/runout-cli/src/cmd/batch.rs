@@ -54,8 +54,8 @@ fn identify_row(exe: &Path, file: &Path, config: &Path, flags: &[String]) -> Res
         .with_context(|| format!("starting {}", exe.display()))?;
     // exit 3 = the report was written but the runout is not (fully) identified: a row with
     // its status, not a failure (crate::exit)
-    let wrote_report = out.status.success()
-        || out.status.code() == Some(i32::from(crate::exit::NOT_IDENTIFIED));
+    let wrote_report =
+        out.status.success() || out.status.code() == Some(i32::from(crate::exit::NOT_IDENTIFIED));
     if !wrote_report {
         let err = String::from_utf8_lossy(&out.stderr);
         let msg = err.trim().strip_prefix("error: ").unwrap_or(err.trim());

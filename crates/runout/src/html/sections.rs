@@ -96,7 +96,11 @@ fn polar(
 ) -> Result<Option<Plot>> {
     let b = v.map(|v| &v.basis);
     let cutter = match b.and_then(|b| b.teeth.zip(b.diameter_mm)) {
-        Some((k, d)) => Some(Cutter::flat(d, k, b.map_or(0.0, |b| b.helix_deg))?),
+        Some((k, d)) => Some(Cutter::flat(
+            d,
+            k,
+            b.map_or(0.0, |b| b.helix_deg).to_radians(),
+        )?),
         None => None,
     };
     let z = b.map_or(0.0, |b| b.height_mm);
