@@ -166,7 +166,13 @@ pub fn run(a: RecordingArgs) -> Result<()> {
         "svg" | "png" => a.plot_format.as_str(),
         other => bail!("--plot-format: expected svg or png, got `{other}`"),
     };
+    for w in &req.assumed {
+        eprintln!("warning: {w}");
+    }
     let report = identify::recordings(&req, &mut crate::progress::Bars::default())?;
+    if report.answer.status != "identified" {
+        crate::exit::not_identified();
+    }
     super::emit(a.json.as_deref(), &report, || recordings_text(&report))?;
     if let Some(dir) = &a.plot_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
