@@ -91,7 +91,7 @@ fn write_tdms(path: &Path, chans: &[(&str, &[f64])]) {
 fn strip(v: &mut Value) {
     match v {
         Value::Object(m) => {
-            for k in ["file", "format", "metadata", "inputs"] {
+            for k in ["file", "format", "metadata", "inputs", "provenance"] {
                 m.remove(k);
             }
             m.values_mut().for_each(strip);

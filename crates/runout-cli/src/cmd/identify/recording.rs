@@ -166,10 +166,12 @@ pub fn run(a: RecordingArgs) -> Result<()> {
         "svg" | "png" => a.plot_format.as_str(),
         other => bail!("--plot-format: expected svg or png, got `{other}`"),
     };
+    let report = identify::recordings(&req, &mut crate::progress::Bars::default())?;
+    // assumed defaults that change the answer, on stderr too (after the job: an input error
+    // stays a plain `error: …` message)
     for w in &req.assumed {
         eprintln!("warning: {w}");
     }
-    let report = identify::recordings(&req, &mut crate::progress::Bars::default())?;
     if report.answer.status != "identified" {
         crate::exit::not_identified();
     }

@@ -58,8 +58,10 @@ pub struct CoefficientAnswer {
 /// Another estimate of the runout, shown as a cross-check.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct CrossCheck {
-    /// Which estimate (e.g. `sine fit of the per-tooth peaks of cut_fz0.05.txt`).
+    /// Which estimate (`sine fit of the per-tooth peaks`).
     pub estimate: String,
+    /// The recording it came from.
+    pub file: String,
     pub offset_um: f64,
     pub offset_um_se: Option<f64>,
     pub angle_deg: f64,
@@ -205,7 +207,8 @@ fn cross_checks(recs: &[RecordingReport], fit_ok: bool) -> Vec<CrossCheck> {
                  lose contact are not either"
             };
             Some(CrossCheck {
-                estimate: format!("sine fit of the per-tooth peaks of {}", r.file),
+                estimate: "sine fit of the per-tooth peaks".into(),
+                file: r.file.clone(),
                 offset_um: s.offset_um,
                 offset_um_se: s.offset_um_se,
                 angle_deg: s.angle_deg,
