@@ -295,3 +295,45 @@ fn exit_code_1_on_bad_input_and_2_on_usage() {
     let h = runout().arg("--help").output().unwrap();
     assert!(String::from_utf8_lossy(&h.stdout).contains("3 ran, but the result is"));
 }
+
+/// Shank sensors: sensor II of the x pair with its sense reversed (968.6 µm − reading: same
+/// range, variations mirrored) → a warning naming the axis; the bundled recording → none.
+#[test]
+fn shank_sensors_of_opposite_sense_are_warned() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(example("shank/recording.csv")).unwrap();
+    let mut out = String::new();
+    for (i, l) in text.lines().enumerate() {
+        if i == 0 {
+            out += l;
+        } else {
+            let mut c: Vec<String> = l.split(',').map(String::from).collect();
+            let x: f64 = c[2].parse().unwrap();
+            c[2] = format!("{:.4}", 968.6 - x);
+            out += &c.join(",");
+        }
+        out.push('\n');
+    }
+    let flipped = dir.path().join("flipped.csv");
+    std::fs::write(&flipped, out).unwrap();
+    let run = |rec: &Path| {
+        let o = runout()
+            .args(["shank", "force"])
+            .arg(rec)
+            .arg("--config")
+            .arg(example("shank/shank.toml"))
+            .args(["--json", "-"])
+            .output()
+            .unwrap();
+        assert!(
+            o.status.code().is_some(),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        json(&o)["warnings"].to_string()
+    };
+    let w = run(&flipped);
+    assert!(w.contains("x signals move in opposite senses"), "{w}");
+    let w = run(&example("shank/recording.csv"));
+    assert!(!w.contains("opposite senses"), "{w}");
+}
