@@ -21,7 +21,6 @@ pub const INPUT_ERROR: u8 = 1;
 static NOT_IDENTIFIED_FLAG: AtomicBool = AtomicBool::new(false);
 
 /// The command's result is not (fully) identified: exit with [`NOT_IDENTIFIED`].
-#[allow(dead_code)] // called by the identify/displacement commands (wired when their reports carry a status)
 pub fn not_identified() {
     NOT_IDENTIFIED_FLAG.store(true, Ordering::Relaxed);
 }

@@ -12,10 +12,11 @@ mod tests;
 
 pub use peaks::{peak_angle, peaks, PeakFitReport, PeaksInputs, PeaksReport, PeaksRequest};
 pub use recordings::{
-    recordings, resolve, Calibration, ChainChoice, ChainDecision, Coefficients, Consistency,
-    Fitted, FullSignal, FullSignalReport, MeanForceN, MeasuringChainReport, Peak, RecordingReport,
-    RecordingRunout, RecordingsInputs, RecordingsReport, RecordingsRequest, Renumbered,
-    SectionReport, SineFitReport, SpindleReport, Status, Verdicts, WaveformPlot,
+    recordings, resolve, Answer, Calibration, ChainChoice, ChainDecision, CoefficientAnswer,
+    Coefficients, Consistency, CrossCheck, Fitted, FullSignal, FullSignalReport, MeanForceN,
+    MeasuringChainReport, Peak, RecordingReport, RecordingRunout, RecordingsInputs,
+    RecordingsReport, RecordingsRequest, Renumbered, RunoutAnswer, SectionReport, SineFitReport,
+    SpindleReport, Status, Verdicts, WaveformPlot,
 };
 pub use render_recordings::recordings_text;
 pub use tests::{

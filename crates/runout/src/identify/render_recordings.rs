@@ -22,6 +22,58 @@ fn profile_label(p: &RadiusProfile) -> String {
     }
 }
 
+/// The answer block that opens the report.
+fn answer_text(a: &super::Answer) -> String {
+    let mut s = String::new();
+    let rho = match (a.runout.offset_um, a.runout.angle_deg) {
+        (Some(o), Some(l)) => format!(
+            "runout ρ = {o:.2} {} µm at λ = {l:.1} {}° (from tooth 0, in the rotation direction)",
+            pm(a.runout.offset_um_se, 1.0, 2),
+            pm(a.runout.angle_deg_se, 1.0, 1)
+        ),
+        (Some(o), None) => format!(
+            "runout ρ = {o:.2} {} µm, angle λ {}",
+            pm(a.runout.offset_um_se, 1.0, 2),
+            if a.runout.angle == "along the tooth line only" {
+                "not observable: offset along the tooth line only".to_string()
+            } else {
+                "not identified".to_string()
+            }
+        ),
+        _ => "runout not identified".to_string(),
+    };
+    let _ = writeln!(s, "\nANSWER: {rho}");
+    let _ = writeln!(s, "  status: {}", a.status);
+    let _ = writeln!(s, "  method: {}", a.method);
+    let ok: Vec<String> = a
+        .coefficients
+        .iter()
+        .filter_map(|c| {
+            c.value
+                .map(|v| format!("{} {v:.1} {} {}", c.name, pm(c.value_se, 1.0, 1), c.unit))
+        })
+        .collect();
+    if !ok.is_empty() {
+        let _ = writeln!(s, "  coefficients: {}", ok.join(", "));
+    }
+    let not: Vec<&str> = a
+        .coefficients
+        .iter()
+        .filter(|c| c.value.is_none())
+        .map(|c| c.name.as_str())
+        .collect();
+    if !not.is_empty() {
+        let _ = writeln!(s, "  not identified: {} (see reasons)", not.join(", "));
+    }
+    for r in &a.reasons {
+        let _ = writeln!(s, "  reason: {r}");
+    }
+    for w in &a.warnings {
+        let _ = writeln!(s, "  warning: {w}");
+    }
+    s
+}
+
 /// True when every recording is a full slot (entry 0°, exit 180°), where the mean-force
 /// calibration is unbiased by runout.
 fn slotting(r: &RecordingsReport) -> bool {
@@ -40,6 +92,8 @@ pub fn recordings_text(r: &RecordingsReport) -> String {
         i.helix_deg,
         profile_label(&i.profile)
     );
+    s += &answer_text(&r.answer);
+    s += "\ndetails (the per-recording sine fits are cross-checks, not the answer):\n";
     for f in &r.recordings {
         s += &recording_text(f);
     }
@@ -117,12 +171,22 @@ fn recording_text(f: &RecordingReport) -> String {
         super::Fitted::Fit(x) => {
             let _ = writeln!(
                 s,
-                "  sine fit (seed 003): ρ = {:.2} {} µm, λ = {:.1} {}°, R² = {:.4}",
+                "  sine fit (seed 003, cross-check): ρ = {:.2} {} µm, λ = {:.1} {}°, R² = {:.4}",
                 x.offset_um,
                 pm(x.offset_um_se, 1.0, 2),
                 x.angle_deg,
                 pm(x.angle_deg_se, 1.0, 1),
                 x.r_squared
+            );
+            let slot = f.entry_deg.abs() < 1e-7 && (f.exit_deg - 180.0).abs() < 1e-7;
+            let _ = writeln!(
+                s,
+                "    {}",
+                if slot {
+                    "(peaks of the resultant only: edge forces and helix are not in its model)"
+                } else {
+                    "(biased at partial immersion: edge forces are not in its model)"
+                }
             );
         }
         super::Fitted::Failed { error } => {
@@ -170,7 +234,7 @@ fn fit_text(r: &RecordingsReport, f: &FullSignalReport) -> String {
     let status = |p: &str| v.parameters.iter().find(|x| x.parameter == p);
     let shown = |p: &str| status(p).is_none_or(|x| x.status == "identified");
     let head = if shown("offset") && shown("angle") {
-        "full-signal fit"
+        "full-signal fit (the answer's source)"
     } else {
         "full-signal fit (NOT IDENTIFIED, see below)"
     };
@@ -200,7 +264,12 @@ fn fit_text(r: &RecordingsReport, f: &FullSignalReport) -> String {
         .enumerate()
         .map(|(i, (c, se))| {
             let value = format!("{c:.1} {} {}", pm(*se, 1.0, 1), units[i]);
-            if se.is_some() && !shown(keys[i]) {
+            let rejected = r
+                .answer
+                .coefficients
+                .get(i)
+                .is_some_and(|a| a.value.is_none());
+            if (se.is_some() && !shown(keys[i])) || rejected {
                 format!("{} not identified ({value})", names[i])
             } else {
                 format!("{} {value}", names[i])

@@ -470,6 +470,10 @@ pub fn force_to(
         )
     });
     let mut zoomed: Vec<(f64, Vec<f64>)> = Vec::new();
+    // sensor I and II displacements per pair during the cut, for the sensor-senses guard
+    // (`plausibility::sensor_senses`): the first SENSES_MAX samples suffice for a correlation
+    const SENSES_MAX: usize = 200_000;
+    let mut senses: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); r.setup.pairs.len()];
     let mut row = vec![0.0; columns.len()];
     let mut consume = |out: &OutputBlock, sink: &mut Option<Sink>| -> Result<()> {
         let np = out.force_n.len();
@@ -497,6 +501,12 @@ pub fn force_to(
             if analysis.cut.is_none_or(|c| n >= c.start && n < c.end) {
                 for (st, f) in stats.iter_mut().zip(&out.force_n) {
                     st.push(f[i]);
+                }
+                for (d, (a, b)) in senses.iter_mut().enumerate() {
+                    if a.len() < SENSES_MAX && d < out.delta_i_um.len() {
+                        a.push(out.delta_i_um[d][i]);
+                        b.push(out.delta_ii_um[d][i]);
+                    }
                 }
             }
             series.push(out.time_s[i], || row[1..].to_vec());
@@ -541,6 +551,14 @@ pub fn force_to(
     let mut analysis = analysis;
     analysis.spectral_resonance = rec.spectral_resonance();
     warnings.extend(analysis.warnings.iter().cloned());
+    for (p, (a, b)) in r.setup.pairs.iter().zip(&senses) {
+        let axis = p.axis.letter().to_string();
+        if let Some(f) = runout_core::plausibility::sensor_senses(a, b, &axis) {
+            warnings.push(format!(
+                "{f} (the forces and the runout of this recording are not to be used)"
+            ));
+        }
+    }
     let axes: Vec<PairAxis> = r.setup.pairs.iter().map(|p| p.axis).collect();
     let seen_usable = analysis.spectral_resonance.map(|seen| {
         let (usable, w) = runout_core::shank::spectral_check(

@@ -174,6 +174,14 @@ pub fn run(a: RecordingArgs) -> Result<()> {
     let mut report = identify::recordings(&req, &mut crate::progress::Bars::default())?;
     a.report.judge(&mut report)?;
     a.report.write(&report)?;
+    // assumed defaults that change the answer, on stderr too (after the job: an input error
+    // stays a plain `error: …` message)
+    for w in &req.assumed {
+        eprintln!("warning: {w}");
+    }
+    if report.answer.status != "identified" {
+        crate::exit::not_identified();
+    }
     super::emit(a.json.as_deref(), &report, || recordings_text(&report))?;
     if let Some(dir) = &a.plot_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;

@@ -8,12 +8,14 @@
 //! the seed-003 sine fit of the per-tooth peaks, the mean-force calibration (≥ 2 feeds), and the
 //! full-signal fit of all recordings jointly through the measuring chain (§4.5, §4.7).
 
+mod answer;
 mod chain;
 mod fit;
 mod read;
 mod report;
 mod request;
 
+pub use answer::{Answer, CoefficientAnswer, CrossCheck, RunoutAnswer};
 pub use chain::{ChainDecision, Consistency, RecordingRunout, Status, Verdicts};
 pub use report::{
     Calibration, Coefficients, Fitted, FullSignal, FullSignalReport, MeanForceN,
@@ -50,6 +52,10 @@ struct FileResult {
     start_angle: f64,
     sine: Result<SineFit, String>,
     reader_warnings: Vec<String>,
+    /// Channels with flat tops at their range limit (pass 1).
+    clipped: Vec<runout_core::plausibility::Finding>,
+    /// Hash of the mapped force samples (the same data passed twice).
+    content_hash: u64,
 }
 
 /// Runs the job: every recording through the signal pipeline (progress: one stage per

@@ -6,13 +6,23 @@ use super::{FileResult, RecordingsRequest};
 use crate::job::{Progress, Source};
 use crate::spill::Spill;
 use anyhow::{bail, Context, Result};
+use runout_core::plausibility::{ClipDetector, Finding};
 use runout_core::signal::{self, Component, PulseConfig, SignalConfig};
 use runout_core::Cut;
 use runout_io::recording::{
     Axis, AxisMapping, Chunk, ReadOptions, RecordingInfo, RecordingReader, ResolvedAxes,
 };
 use runout_io::units::Quantity;
+use std::hash::Hasher;
 use std::io::BufRead;
+
+/// What pass 1 saw besides the signal: flat tops at a channel's range limit and a hash of the
+/// mapped samples (for the same data passed twice).
+#[derive(Default)]
+struct Watch {
+    clip: [ClipDetector; 3],
+    hash: std::hash::DefaultHasher,
+}
 
 /// Rows per chunk of pass 1.
 const ROWS: usize = 65_536;
@@ -128,16 +138,25 @@ pub(super) fn analyse(
     progress.begin(src.name(), Some(total));
     let has_z = ch.axes.has(Axis::Z);
     let mut pass = 0;
+    let mut watch = Watch::default();
     let analysis = signal::analyse_replay::<anyhow::Error, _>(&cfg, |sink| {
         pass += 1;
         if pass == 1 {
-            first_pass(&mut reader, &ch, &mut spill, progress, sink)
+            first_pass(&mut reader, &ch, &mut spill, progress, sink, &mut watch)
         } else {
             replay(&mut spill, has_z, progress, sink)
         }
     })?;
     progress.end();
     let reader_warnings = reader.warnings().to_vec();
+    let names = ["x", "y", "z"];
+    let clipped: Vec<Finding> = watch
+        .clip
+        .iter()
+        .zip(names)
+        .filter(|(_, a)| *a != "z" || has_z)
+        .filter_map(|(d, a)| d.finding(&format!("{} (workpiece {a})", src.name()), "N"))
+        .collect();
     let avg = &analysis.average;
     let mean = |c: Component| {
         let m = &avg.component(c).mean;
@@ -160,6 +179,8 @@ pub(super) fn analyse(
         start_angle: f64::NAN,
         sine,
         reader_warnings,
+        clipped,
+        content_hash: watch.hash.finish(),
     })
 }
 
@@ -170,6 +191,7 @@ fn first_pass<R: BufRead>(
     spill: &mut Spill,
     progress: &mut dyn Progress,
     sink: &mut signal::ChunkSink<'_>,
+    watch: &mut Watch,
 ) -> Result<()> {
     let mut chunk = Chunk::default();
     let mut out = Chunk {
@@ -196,6 +218,17 @@ fn first_pass<R: BufRead>(
         for (v, f) in [fx, fy, fz].into_iter().zip(&ch.factors) {
             if *f != 1.0 {
                 v.iter_mut().for_each(|x| *x *= f);
+            }
+        }
+        for (k, v) in out
+            .values
+            .iter()
+            .take(if has_z { 3 } else { 2 })
+            .enumerate()
+        {
+            watch.clip[k].push(v);
+            for x in v {
+                watch.hash.write_u64(x.to_bits());
             }
         }
         if let Some(i) = ch.pulse {

@@ -1,4 +1,4 @@
-//! The report of `identify RECORDING…` (`runout.identify.recording/1`) and its construction.
+//! The report of `identify RECORDING…` (`runout.identify.recording/2`) and its construction.
 
 use super::fit::{
     fitted_radius_difference_um, model_waveforms, radius_difference_um, radius_difference_warnings,
@@ -241,12 +241,17 @@ pub struct WaveformPlot {
     pub components: usize,
 }
 
-/// `runout.identify.recording/1`: runout and cutting coefficients from force recordings.
+/// `runout.identify.recording/2`: runout and cutting coefficients from force recordings.
+/// (`/2` added `answer`, the one result to use, first.)
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct RecordingsReport {
-    /// `runout.identify.recording/1`
-    #[schemars(extend("const" = "runout.identify.recording/1"))]
+    /// `runout.identify.recording/2`
+    #[schemars(extend("const" = "runout.identify.recording/2"))]
     pub schema: String,
+    /// The one answer: runout ρ ± SE, λ ± SE, the method, the status (`identified` /
+    /// `partly identified` / `not identified`) with the reasons, the coefficients each with its
+    /// status, the plausibility warnings and the sine fits as cross-checks.
+    pub answer: super::answer::Answer,
     pub conventions: String,
     pub inputs: RecordingsInputs,
     pub recordings: Vec<RecordingReport>,
@@ -268,7 +273,7 @@ pub struct RecordingsReport {
 }
 
 impl Report for RecordingsReport {
-    const SCHEMA: &'static str = "runout.identify.recording/1";
+    const SCHEMA: &'static str = "runout.identify.recording/2";
 }
 
 const DEG: f64 = 57.29577951308232; // 1f64.to_degrees()
@@ -453,16 +458,27 @@ pub(super) fn build(
     extra: &Extra,
 ) -> RecordingsReport {
     let c = &req.cutter;
+    let full_signal = fit_report(fit, files);
+    let recordings: Vec<RecordingReport> = files.iter().map(|f| recording_report(req, f)).collect();
+    let answer = super::answer::build(
+        req,
+        files,
+        &full_signal,
+        &extra.verdicts,
+        &recordings,
+        &extra.decision.used,
+    );
     let mut report = RecordingsReport {
         schema: RecordingsReport::SCHEMA.into(),
+        answer,
         conventions: "angles from tooth 0 in the direction of rotation; forces on the workpiece; tooth 0 is absolute only with a pulse channel and tooth0_angle_deg, otherwise the first tooth period of the average".into(),
         inputs: inputs(req, files),
-        recordings: files.iter().map(|f| recording_report(req, f)).collect(),
+        recordings,
         mean_force_calibration: match cal {
             Err(e) => Calibration::Skipped { skipped: e.clone() },
             Ok(k) => Calibration::Fitted(Box::new(k.clone())),
         },
-        full_signal: fit_report(fit, files),
+        full_signal,
         measuring_chain: MeasuringChainReport {
             decision: extra.decision.clone(),
             fit: fit.as_ref().ok().and_then(|f| f.chain.clone()),

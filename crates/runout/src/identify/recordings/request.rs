@@ -68,6 +68,10 @@ pub struct RecordingsRequest {
     pub chain: ChainChoice,
     /// Start values of the fitted modes' natural frequencies (Hz): one, or per axis x, y[, z].
     pub sensor_mode_hz: Option<Vec<f64>>,
+    /// Parameters that change the answer and were not given, so their defaults were assumed,
+    /// each as a warning naming the flag (e.g. `assumed helix 0°: pass --helix-deg`); filled by
+    /// [`resolve`], reported in the answer's warnings.
+    pub assumed: Vec<String>,
 }
 
 impl RecordingsRequest {
@@ -87,6 +91,7 @@ impl RecordingsRequest {
             fit_tilt: false,
             chain: ChainChoice::Auto,
             sensor_mode_hz: None,
+            assumed: Vec::new(),
         }
     }
 
@@ -169,5 +174,23 @@ pub fn resolve(
     }
     s.push(flags);
     let case = resolve_identify(&s, recordings.len())?;
-    Ok(RecordingsRequest::from_case(recordings, case))
+    let mut assumed = Vec::new();
+    if !s.has("helix_deg") {
+        assumed.push(
+            "assumed helix 0° (straight flutes): pass --helix-deg (or helix_deg in the config); \
+             on a helical cutter the coefficients and the angle change"
+                .to_string(),
+        );
+    }
+    if !s.has("profile") {
+        assumed.push(
+            "assumed a flat end mill: pass --profile (ball, bull_nose with --corner-radius-mm, \
+             tapered) when the cut is on a rounded or tapered end"
+                .to_string(),
+        );
+    }
+    Ok(RecordingsRequest {
+        assumed,
+        ..RecordingsRequest::from_case(recordings, case)
+    })
 }
