@@ -60,7 +60,14 @@ fn cutters() -> Vec<Cutter> {
             RadiusProfile::Flat,
         )
         .unwrap(),
-        Cutter::new(6.0, vec![tau / 3.0; 3], 30f64.to_radians(), 20.0, RadiusProfile::Ball).unwrap(),
+        Cutter::new(
+            6.0,
+            vec![tau / 3.0; 3],
+            30f64.to_radians(),
+            20.0,
+            RadiusProfile::Ball,
+        )
+        .unwrap(),
     ]
 }
 

@@ -1,0 +1,15 @@
+//! The integration tests of `runout-io`, one test binary (one link) for all of them (issue 13).
+//! Each module is a former `tests/<name>.rs`; filter with `cargo test -p runout-io --test io <name>::`.
+//! Data stays in `tests/data` and `tests/fixtures` (paths from `CARGO_MANIFEST_DIR`).
+
+mod displacement;
+mod error_chain;
+mod formats;
+mod formats_mutated;
+mod gcode;
+mod grind_csv;
+mod issue14_regressions;
+mod mutated_inputs;
+mod plots;
+mod recording;
+mod toolpath;
