@@ -1,5 +1,7 @@
 //! The integration tests of `runout-core`, one test binary (one link) for all of them (issue 13).
 //! Each module is a former `tests/<name>.rs`; filter with `cargo test -p runout-core --test core <name>::`.
+//! Proptest regression seeds: `tests/proptest-regressions/<module>.txt` (proptest's `SourceParallel`
+//! lookup for a module of a `main.rs`: the `main.rs` directory is replaced by `proptest-regressions`).
 
 mod chip_lookback;
 mod chip_models;
