@@ -4,7 +4,7 @@
 //!
 //! Group `identify_chain` (issue 11 target: the joint fit of five recordings with a fitted mode
 //! ≤ 1 s, reported as a ratio to the rigid fit of the same data in the same run): the 2-flute
-//! Ø20, helix 40°, slot a_p 4 mm, 7500 rpm, 12 kHz, five-feed data of `tests/identify_chain.rs`
+//! Ø20, helix 40°, slot a_p 4 mm, 7500 rpm, 12 kHz, five-feed data of `tests/core/identify_chain.rs`
 //! (ρ 10 µm, a 1100 Hz / ζ 0.03 mode on x and y, 2 % white + coloured noise, 20 revolutions
 //! averaged), fitted with `ChainModel::FitModes` (modes scanned, angle shifts free) and with the
 //! rigid `FullSignalOptions::default()`.
@@ -105,7 +105,7 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-/// The five resonant recordings of `tests/identify_chain.rs` (same simulation and noise).
+/// The five resonant recordings of `tests/core/identify_chain.rs` (same simulation and noise).
 fn chain_cases() -> Vec<WaveformCase> {
     const OVERSAMPLE: usize = 8;
     let mode = SensorMode::new(1100.0, 0.03, 1.0).unwrap();

@@ -14,7 +14,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rand::{rngs::StdRng, SeedableRng};
 use rand_distr::{Distribution, Normal};
 use runout_core::signal::{
-    analyse_replay, Chunk, ChunkSink, PhaseTracker, SignalConfig, SignalError, SpindleScan,
+    analyse_replay, ChunkSink, PhaseTracker, SignalChunk, SignalConfig, SignalError, SpindleScan,
     SyncAverager,
 };
 use runout_core::*;
@@ -68,7 +68,7 @@ fn replay<'b>(b: &'b Buffers) -> impl FnMut(&mut ChunkSink<'_>) -> Result<(), Si
             } else {
                 &b.cut
             };
-            sink(Chunk::xyz(&v[0], &v[1], &v[2]))?;
+            sink(SignalChunk::xyz(&v[0], &v[1], &v[2]))?;
         }
         Ok(())
     }
@@ -122,7 +122,7 @@ fn bench(c: &mut Criterion) {
             let mut total = 0.0;
             for _ in 0..3 {
                 let mut f = replay(&b);
-                f(&mut |c: Chunk| {
+                f(&mut |c: SignalChunk| {
                     total += c.fx.iter().sum::<f64>()
                         + c.fy.iter().sum::<f64>()
                         + c.fz.map_or(0.0, |z| z.iter().sum());

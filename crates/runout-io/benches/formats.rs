@@ -6,7 +6,7 @@
 //! criterion's throughput is bytes of the file (MB/s); samples/s = 1e6 × 4 / time.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use runout_io::recording::{open_recording, Chunk, ReadOptions};
+use runout_io::recording::{open_recording, ReadOptions, RecordingChunk};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 
@@ -29,7 +29,7 @@ fn files() -> Option<PathBuf> {
 
 fn read_all(path: &Path) -> f64 {
     let mut r = open_recording(path, &ReadOptions::new().channels(&["Fx", "Fy", "Fz"])).unwrap();
-    let mut c = Chunk::default();
+    let mut c = RecordingChunk::default();
     let mut sum = 0.0;
     while r.read_chunk(&mut c, 65_536).unwrap() > 0 {
         sum += c.values[0].iter().sum::<f64>() + c.time_s[c.len() - 1];

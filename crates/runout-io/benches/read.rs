@@ -3,7 +3,7 @@
 //! `str::parse::<f64>` per cell (what a straightforward implementation would do).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use runout_io::recording::{Chunk, ReadOptions, RecordingReader};
+use runout_io::recording::{ReadOptions, RecordingChunk, RecordingReader};
 use std::hint::black_box;
 
 /// A 50 kHz recording: time + 4 force-like channels with 4–6 significant digits.
@@ -25,7 +25,7 @@ fn generate(rows: usize) -> Vec<u8> {
 
 fn read_all_ours(bytes: &[u8]) -> f64 {
     let mut r = RecordingReader::from_bytes("bench.csv", bytes, &ReadOptions::new()).unwrap();
-    let mut c = Chunk::default();
+    let mut c = RecordingChunk::default();
     let mut sum = 0.0;
     while r.read_chunk(&mut c, 65_536).unwrap() > 0 {
         sum += c.values[0].iter().sum::<f64>();

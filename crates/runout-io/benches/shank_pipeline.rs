@@ -9,7 +9,7 @@ use runout_core::shank::{
     SyntheticShank,
 };
 use runout_io::recording::{
-    BinaryLayout, BinaryWriter, Chunk, CsvWriter, ReadOptions, RecordingReader,
+    BinaryLayout, BinaryWriter, CsvWriter, ReadOptions, RecordingChunk, RecordingReader,
 };
 use std::f64::consts::TAU;
 use std::hint::black_box;
@@ -87,7 +87,7 @@ fn setup() -> ShankSetup {
     )
 }
 
-fn to_mm(c: &mut Chunk) {
+fn to_mm(c: &mut RecordingChunk) {
     c.values
         .iter_mut()
         .for_each(|v| v.iter_mut().for_each(|x| *x *= 1e-3));
@@ -97,7 +97,7 @@ fn pipeline(bytes: &[u8], csv: bool) -> f64 {
     let opts = ReadOptions::new();
     let mut survey = Survey::new(&setup()).unwrap();
     let mut r = RecordingReader::from_bytes("bench.csv", bytes, &opts).unwrap();
-    let mut c = Chunk::default();
+    let mut c = RecordingChunk::default();
     while r.read_chunk(&mut c, 65_536).unwrap() > 0 {
         to_mm(&mut c);
         let cols: Vec<&[f64]> = c.values.iter().map(Vec::as_slice).collect();
@@ -152,7 +152,7 @@ fn pipeline(bytes: &[u8], csv: bool) -> f64 {
 
 fn parse_only(bytes: &[u8]) -> f64 {
     let mut r = RecordingReader::from_bytes("bench.csv", bytes, &ReadOptions::new()).unwrap();
-    let mut c = Chunk::default();
+    let mut c = RecordingChunk::default();
     let mut acc = 0.0;
     while r.read_chunk(&mut c, 65_536).unwrap() > 0 {
         acc += c.values[0][0];

@@ -4,7 +4,7 @@
 //!
 //! `cargo run --release -p runout-io --example read_throughput -- FILE.csv runout|csv`
 
-use runout_io::recording::{Chunk, ReadOptions, RecordingReader};
+use runout_io::recording::{ReadOptions, RecordingChunk, RecordingReader};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
@@ -17,7 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (rows, sum) = match mode {
         "runout" => {
             let mut r = RecordingReader::open(path, &ReadOptions::new())?;
-            let mut c = Chunk::default();
+            let mut c = RecordingChunk::default();
             let (mut rows, mut sum) = (0usize, 0.0);
             while r.read_chunk(&mut c, 65_536)? > 0 {
                 rows += c.len();

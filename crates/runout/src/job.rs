@@ -222,7 +222,7 @@ mod tests {
         // messages name the in-memory source like a file, with its line
         let bad = Source::bytes("mem.csv", &b"time_s,a_um\n0,1\n0.001,x\n"[..]);
         let mut r = bad.open_recording(&o).unwrap();
-        let mut chunk = runout_io::recording::Chunk::default();
+        let mut chunk = runout_io::recording::RecordingChunk::default();
         let e = loop {
             match r.read_chunk(&mut chunk, 10) {
                 Ok(0) => panic!("bad value accepted"),
@@ -254,7 +254,7 @@ mod tests {
         let s = Source::arrays("numpy", arrays);
         let mut r = s.open_recording(&ReadOptions::new()).unwrap();
         assert_eq!(r.info().file, "numpy");
-        let mut chunk = runout_io::recording::Chunk::default();
+        let mut chunk = runout_io::recording::RecordingChunk::default();
         r.read_chunk(&mut chunk, 1000).unwrap();
         assert_eq!(chunk.channel(0), &a[..]);
         // as text: the same values, exactly, through a CSV reader

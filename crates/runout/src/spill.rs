@@ -5,7 +5,7 @@
 //! Layout, per block: u64 LE row count, then each channel's values as f64 LE. The file is
 //! deleted when the [`Spill`] is dropped (also on errors).
 
-use runout_io::recording::Chunk;
+use runout_io::recording::RecordingChunk;
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
@@ -51,7 +51,7 @@ impl Spill {
 
     /// Append the chunk's channels (its time column is not kept: pass 2 numbers samples from
     /// 0). Panics if called after [`Spill::reader`].
-    pub fn write(&mut self, chunk: &Chunk) -> io::Result<()> {
+    pub fn write(&mut self, chunk: &RecordingChunk) -> io::Result<()> {
         let w = self
             .writer
             .as_mut()
@@ -101,7 +101,7 @@ pub struct SpillReader {
 
 impl SpillReader {
     /// The next block into `chunk` (values only, `first_sample` set, no time column); 0 at the end.
-    pub fn read_chunk(&mut self, chunk: &mut Chunk) -> io::Result<usize> {
+    pub fn read_chunk(&mut self, chunk: &mut RecordingChunk) -> io::Result<usize> {
         let mut head = [0u8; 8];
         match self.r.read_exact(&mut head) {
             Ok(()) => {}
@@ -135,7 +135,7 @@ mod tests {
     fn blocks_come_back_bit_for_bit_and_the_file_is_removed() {
         let path = Spill::temp_path("test");
         let mut s = Spill::create(path.clone(), 2).unwrap();
-        let mut c = Chunk {
+        let mut c = RecordingChunk {
             time_s: vec![0.0, 0.1, 0.2],
             values: vec![vec![1.0, f64::NAN, -0.0], vec![1e-300, 2.5, f64::INFINITY]],
             ..Default::default()
@@ -146,7 +146,7 @@ mod tests {
         s.write(&c).unwrap();
         assert_eq!(s.rows(), 4);
         let mut r = s.reader().unwrap();
-        let mut back = Chunk::default();
+        let mut back = RecordingChunk::default();
         assert_eq!(r.read_chunk(&mut back).unwrap(), 3);
         assert_eq!(back.first_sample, 0);
         assert!(back.values[0][1].is_nan() && back.values[0][2].is_sign_negative());

@@ -15,7 +15,7 @@
 //! swing, a CL-path segment), the look-back poses are reached by rotating the ray's pose through
 //! the small angle rate·τ, and the spindle point at an iterate z′ by turning the prepared one
 //! through ψ(z′) − ψ(z) ([`ToolKinematics::spindle_point_near`]) — series sin/cos, no libm call
-//! per iteration; the same values to rounding (tests/chip_models.rs). Measured in the same run
+//! per iteration; the same values to rounding (tests/core/chip_models.rs). Measured in the same run
 //! (thread CPU time, `benches/chip.rs` points): 1.10 → 1.38 M points/s on the swing, 0.81 → 1.22 M
 //! on the CL path, 3-axis unchanged. A second-order analytic start for (τ, z′, s) in the turning
 //! frame was tried: it brings the swing to 1.00 Newton iteration per pass (from 2.2) but costs
@@ -246,7 +246,7 @@ pub fn crossing_at<M: ToolMotion>(
         // converged when this step is below the tolerance, or when the next one must be: Newton
         // converges quadratically, |e_{k+1}| ≤ C·|e_k|² with C ≈ (1 + tan²β)/(2R) from the edge
         // curvature in t′ and z′; with the safety factor 20 in `curvature` the accepted iterate is
-        // within tol (tested against an 8-iteration solve without early exit in tests/chip_models.rs)
+        // within tol (tested against an 8-iteration solve without early exit in tests/core/chip_models.rs)
         if step < opts.tol_mm || curvature * step * step < opts.tol_mm {
             converged = true;
             break;

@@ -67,7 +67,7 @@ pub trait ToolMotion: Send + Sync {
 ///
 /// (exact for [`StraightFeed`], [`ConstantSwing`] and each segment of a [`ClPath`]). The rotation
 /// by a small angle uses [`small_sin_cos`]: no libm call, same result as [`ToolMotion::pose`] to
-/// rounding (|δP| ~ 1e-14 mm on the benchmark paths, tested in `tests/chip_models.rs`).
+/// rounding (|δP| ~ 1e-14 mm on the benchmark paths, tested in `tests/core/chip_models.rs`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RigidStep {
     /// Reference time t_r (s).

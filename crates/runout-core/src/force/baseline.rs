@@ -1,6 +1,6 @@
 //! The force kernel as it was before issue 18 (one scalar loop per sample, every tooth × disk
 //! tested): kept as the baseline of the `force_kernel` benchmark and as the oracle of the
-//! kernel's equivalence tests (`tests/force_simulation.rs`). Not for production use.
+//! kernel's equivalence tests (`tests/core/force_simulation.rs`). Not for production use.
 
 use super::{ForceModel, ForceSeries, Sampling};
 use crate::angle::wrap_tau;

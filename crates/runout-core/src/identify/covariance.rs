@@ -20,7 +20,7 @@
 //! quantity's row weights w = J(JᵀJ)⁻¹g). A parameter such as ρ draws its information from a
 //! handful of harmonics (the runout lines k ≢ 0 mod K), so that sum has few effective degrees of
 //! freedom, is skewed, and is low more often than high: in the Monte-Carlo test
-//! `tests/identify_coverage.rs` (an unmodelled 6 kHz mode, coloured noise, 200 recordings) ±2 SE
+//! `tests/core/identify_coverage.rs` (an unmodelled 6 kHz mode, coloured noise, 200 recordings) ±2 SE
 //! of ρ covered the truth in 85 % of the fits (and the classic SE in 80 %). As for
 //! cluster-robust inference with few clusters (Satterthwaite, Bell–McCaffrey), the effective
 //! degrees of freedom are ν = (Σ_g b_g)²/Σ_g b_g², b_g = ‖w_g‖²·P̂_g the expected share of

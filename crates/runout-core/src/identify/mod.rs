@@ -72,5 +72,3 @@ pub use sine_fit::{
     SineHypothesis, ToothPeaks,
 };
 pub use waveform::{AveragedWaveform, FrameAxis, WaveformCase, WaveformComponent};
-#[doc(hidden)]
-pub use waveform::{Axis, Component};

@@ -40,7 +40,7 @@
 //! engagement runs with lane masks, SIMD lanes selected at run time); the simulation multiplies
 //! them by the coefficients, the identification adds the derivatives.
 
-use super::waveform::Axis;
+use super::waveform::FrameAxis;
 use crate::angle::wrap_tau;
 use crate::coefficients::CuttingCoefficients;
 use crate::cut::Cut;
@@ -474,36 +474,36 @@ impl RevolutionModel {
 
 /// Force component `axis` (N) of sample sums `b` with coefficients `kc` (module docs).
 #[inline]
-pub fn force_from_basis(axis: Axis, b: &[f64; NB], kc: &CuttingCoefficients) -> f64 {
+pub fn force_from_basis(axis: FrameAxis, b: &[f64; NB], kc: &CuttingCoefficients) -> f64 {
     match axis {
-        Axis::X => {
+        FrameAxis::X => {
             kc.ktc * b[0] + kc.krc * b[7] - kc.kac * b[11] + kc.kte * b[2] + kc.kre * b[9]
                 - kc.kae * b[13]
         }
-        Axis::Y => {
+        FrameAxis::Y => {
             -kc.ktc * b[1] + kc.krc * b[6] - kc.kac * b[10] - kc.kte * b[3] + kc.kre * b[8]
                 - kc.kae * b[12]
         }
-        Axis::Z => -kc.krc * b[14] - kc.kre * b[15] - kc.kac * b[4] - kc.kae * b[5],
+        FrameAxis::Z => -kc.krc * b[14] - kc.kre * b[15] - kc.kac * b[4] - kc.kae * b[5],
     }
 }
 
 /// Derivatives ∂F_axis/∂(K_tc, K_rc, K_ac, K_te, K_re, K_ae) of sample sums `b`.
 #[inline]
-pub fn coefficient_gradient(axis: Axis, b: &[f64; NB]) -> [f64; 6] {
+pub fn coefficient_gradient(axis: FrameAxis, b: &[f64; NB]) -> [f64; 6] {
     match axis {
-        Axis::X => [b[0], b[7], -b[11], b[2], b[9], -b[13]],
-        Axis::Y => [-b[1], b[6], -b[10], -b[3], b[8], -b[12]],
-        Axis::Z => [0.0, -b[14], -b[4], 0.0, -b[15], -b[5]],
+        FrameAxis::X => [b[0], b[7], -b[11], b[2], b[9], -b[13]],
+        FrameAxis::Y => [-b[1], b[6], -b[10], -b[3], b[8], -b[12]],
+        FrameAxis::Z => [0.0, -b[14], -b[4], 0.0, -b[15], -b[5]],
     }
 }
 
 /// ∂F_axis/∂p from the runout derivative sums `d` = ∂[S₀, S₁, S₄, S₆, S₇, S₁₀, S₁₁, S₁₄]/∂p.
 #[inline]
-pub fn runout_gradient(axis: Axis, d: &[f64; ND], kc: &CuttingCoefficients) -> f64 {
+pub fn runout_gradient(axis: FrameAxis, d: &[f64; ND], kc: &CuttingCoefficients) -> f64 {
     match axis {
-        Axis::X => kc.ktc * d[0] + kc.krc * d[4] - kc.kac * d[6],
-        Axis::Y => -kc.ktc * d[1] + kc.krc * d[3] - kc.kac * d[5],
-        Axis::Z => -kc.krc * d[7] - kc.kac * d[2],
+        FrameAxis::X => kc.ktc * d[0] + kc.krc * d[4] - kc.kac * d[6],
+        FrameAxis::Y => -kc.ktc * d[1] + kc.krc * d[3] - kc.kac * d[5],
+        FrameAxis::Z => -kc.krc * d[7] - kc.kac * d[2],
     }
 }

@@ -39,13 +39,6 @@ impl FrameAxis {
     }
 }
 
-/// Former name of [`FrameAxis`], kept until the callers outside this crate are renamed.
-#[doc(hidden)]
-pub use self::FrameAxis as Axis;
-/// Former name of [`WaveformComponent`], kept until the callers outside this crate are renamed.
-#[doc(hidden)]
-pub use self::WaveformComponent as Component;
-
 /// One measured force component over one revolution.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WaveformComponent {

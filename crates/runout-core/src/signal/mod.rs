@@ -60,12 +60,6 @@ pub use average::{
     AngleReference, ComponentAverage, SyncAverage, SyncAverager, ToothPeakEstimate, ToothReference,
 };
 pub use chunk::SignalChunk;
-/// Former name of [`SignalChunk`], kept until the callers outside this crate are renamed.
-#[doc(hidden)]
-pub use chunk::SignalChunk as Chunk;
-/// Former name of [`ForceComponent`], kept until the callers outside this crate are renamed.
-#[doc(hidden)]
-pub use config::ForceComponent as Component;
 pub use config::{ForceComponent, PulseConfig, SignalConfig};
 pub use error::SignalError;
 pub use pulse::PulseEdgeDetector;

@@ -90,7 +90,7 @@ pub fn recording_from_arrays(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::recording::Chunk;
+    use crate::recording::RecordingChunk as Chunk;
 
     fn arrays(cols: &[(&str, Vec<f64>)]) -> Arrays {
         Arrays {

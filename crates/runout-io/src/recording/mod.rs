@@ -34,10 +34,6 @@ mod writer;
 
 pub use crate::formats::{open_recording, recording_from_bytes};
 pub use axis::AxisMappingError;
-/// Former name of [`FrameAxis`] (now shared with `runout_core::identify`), kept until the callers
-/// outside this crate are renamed.
-#[doc(hidden)]
-pub use axis::FrameAxis as Axis;
 pub use axis::{AxisMapping, AxisSource, FrameAxis, ResolvedAxes};
 pub use error::RecordingError;
 pub use reader::{RecordingReader, DEFAULT_CHUNK_ROWS};
@@ -214,10 +210,6 @@ impl RecordingInfo {
             .map(|n| n.saturating_sub(1) as f64 / self.sample_rate_hz)
     }
 }
-
-/// Former name of [`RecordingChunk`], kept until the callers outside this crate are renamed.
-#[doc(hidden)]
-pub type Chunk = RecordingChunk;
 
 /// A block of consecutive samples: time and one vector per delivered channel.
 #[derive(Debug, Clone, Default, PartialEq)]

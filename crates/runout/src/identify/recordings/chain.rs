@@ -7,7 +7,7 @@ use crate::job::Source;
 use runout_core::angle::wrap_pi;
 use runout_core::chain::{AxisChain, MeasuringChain, SensorMode};
 use runout_core::identify::{
-    full_signal_fit, residual_at, Axis as FitAxis, ChainModel, ChainOptions, FullSignalFit,
+    full_signal_fit, residual_at, ChainModel, ChainOptions, FrameAxis as FitAxis, FullSignalFit,
     FullSignalOptions, RunoutObservability,
 };
 use runout_core::signal::ToothReference;

@@ -4,11 +4,11 @@
 use super::{FileResult, RecordingsRequest};
 use runout_core::identify::{
     calibrate_mean_forces, full_signal_fit, harmonic_start_angle, peak_immersion,
-    radius_difference, refine_start_angle, sine_fit, AveragedWaveform, Axis as FitAxis,
-    Component as FitComponent, FullSignalFit, FullSignalOptions, MeanForceCalibration, MeanForces,
-    PeakConditions, SineFit, SineHypothesis, ToothPeaks, WaveformCase,
+    radius_difference, refine_start_angle, sine_fit, AveragedWaveform, FrameAxis as FitAxis,
+    FullSignalFit, FullSignalOptions, MeanForceCalibration, MeanForces, PeakConditions, SineFit,
+    SineHypothesis, ToothPeaks, WaveformCase, WaveformComponent as FitComponent,
 };
-use runout_core::signal::{Component, SignalAnalysis, ToothReference};
+use runout_core::signal::{ForceComponent, SignalAnalysis, ToothReference};
 use runout_core::{angle::wrap_pi, Cut, Cutter, CuttingCoefficients};
 
 pub(super) fn peak_sine_fit(
@@ -116,18 +116,18 @@ pub(super) fn initial_start_angle(
 
 pub(super) fn waveform_case(cutter: &Cutter, f: &FileResult) -> WaveformCase {
     let avg = &f.analysis.average;
-    let comp = |c: Component, axis: FitAxis| {
+    let comp = |c: ForceComponent, axis: FitAxis| {
         let x = avg.component(c);
         let values = x.mean.clone();
         let se = Some(x.se.clone()).filter(|s| s.iter().all(|v| v.is_finite() && *v > 0.0));
         FitComponent { axis, values, se }
     };
     let mut components = vec![
-        comp(Component::Fx, FitAxis::X),
-        comp(Component::Fy, FitAxis::Y),
+        comp(ForceComponent::Fx, FitAxis::X),
+        comp(ForceComponent::Fy, FitAxis::Y),
     ];
     if avg.has_fz {
-        components.push(comp(Component::Fz, FitAxis::Z));
+        components.push(comp(ForceComponent::Fz, FitAxis::Z));
     }
     WaveformCase {
         cutter: cutter.clone(),

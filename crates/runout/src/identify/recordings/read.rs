@@ -7,10 +7,11 @@ use crate::job::{Progress, Source};
 use crate::spill::Spill;
 use anyhow::{bail, Context, Result};
 use runout_core::plausibility::{ClipDetector, Finding};
-use runout_core::signal::{self, Component, PulseConfig, SignalConfig};
+use runout_core::signal::{self, ForceComponent, PulseConfig, SignalConfig};
 use runout_core::Cut;
 use runout_io::recording::{
-    Axis, AxisMapping, Chunk, ReadOptions, RecordingInfo, RecordingReader, ResolvedAxes,
+    AxisMapping, FrameAxis, ReadOptions, RecordingChunk, RecordingInfo, RecordingReader,
+    ResolvedAxes,
 };
 use runout_io::units::Quantity;
 use std::hash::Hasher;
@@ -63,10 +64,10 @@ fn channels(name: &str, info: &RecordingInfo, req: &RecordingsRequest) -> Result
         })?,
     };
     let axes = mapping.resolve(info)?;
-    if !(axes.has(Axis::X) && axes.has(Axis::Y)) {
+    if !(axes.has(FrameAxis::X) && axes.has(FrameAxis::Y)) {
         bail!("{name}: the axis mapping `{mapping}` must give both x and y");
     }
-    let factors: Vec<f64> = Axis::ALL
+    let factors: Vec<f64> = FrameAxis::ALL
         .iter()
         .map(|&ax| {
             mapping
@@ -136,7 +137,7 @@ pub(super) fn analyse(
     let total =
         info.file_bytes.unwrap_or(0) + 2 * 8 * columns as u64 * info.expected_samples.unwrap_or(0);
     progress.begin(src.name(), Some(total));
-    let has_z = ch.axes.has(Axis::Z);
+    let has_z = ch.axes.has(FrameAxis::Z);
     let mut pass = 0;
     let mut watch = Watch::default();
     let analysis = signal::analyse_replay::<anyhow::Error, _>(&cfg, |sink| {
@@ -158,16 +159,16 @@ pub(super) fn analyse(
         .filter_map(|(d, a)| d.finding(&format!("{} (workpiece {a})", src.name()), "N"))
         .collect();
     let avg = &analysis.average;
-    let mean = |c: Component| {
+    let mean = |c: ForceComponent| {
         let m = &avg.component(c).mean;
         m.iter().sum::<f64>() / m.len().max(1) as f64
     };
     let fz = if avg.has_fz {
-        mean(Component::Fz)
+        mean(ForceComponent::Fz)
     } else {
         f64::NAN
     };
-    let mean_force = [mean(Component::Fx), mean(Component::Fy), fz];
+    let mean_force = [mean(ForceComponent::Fx), mean(ForceComponent::Fy), fz];
     let sine = peak_sine_fit(&req.cutter, cut, &analysis);
     Ok(FileResult {
         name: src.name().to_string(),
@@ -193,12 +194,12 @@ fn first_pass<R: BufRead>(
     sink: &mut signal::ChunkSink<'_>,
     watch: &mut Watch,
 ) -> Result<()> {
-    let mut chunk = Chunk::default();
-    let mut out = Chunk {
+    let mut chunk = RecordingChunk::default();
+    let mut out = RecordingChunk {
         values: vec![Vec::new(); 3],
         ..Default::default()
     };
-    let has_z = ch.axes.has(Axis::Z);
+    let has_z = ch.axes.has(FrameAxis::Z);
     loop {
         let n = reader.read_chunk(&mut chunk, ROWS)?;
         if n == 0 {
@@ -209,9 +210,9 @@ fn first_pass<R: BufRead>(
         let [fx, fy, fz] = &mut out.values[..] else {
             unreachable!("three force columns")
         };
-        ch.axes.map_chunk(&chunk, Axis::X, fx);
-        ch.axes.map_chunk(&chunk, Axis::Y, fy);
-        if !ch.axes.map_chunk(&chunk, Axis::Z, fz) {
+        ch.axes.map_chunk(&chunk, FrameAxis::X, fx);
+        ch.axes.map_chunk(&chunk, FrameAxis::Y, fy);
+        if !ch.axes.map_chunk(&chunk, FrameAxis::Z, fz) {
             fz.clear();
             fz.resize(n, 0.0);
         }
@@ -242,8 +243,8 @@ fn first_pass<R: BufRead>(
 }
 
 /// A spilled or mapped chunk (fx, fy, fz[, pulse]) as the signal pipeline's chunk.
-fn as_signal(c: &Chunk, has_z: bool) -> signal::Chunk<'_> {
-    signal::Chunk {
+fn as_signal(c: &RecordingChunk, has_z: bool) -> signal::SignalChunk<'_> {
+    signal::SignalChunk {
         fx: &c.values[0],
         fy: &c.values[1],
         fz: has_z.then_some(&c.values[2][..]),
@@ -261,7 +262,7 @@ fn replay(
     let mut r = spill
         .reader()
         .with_context(|| format!("reading temporary file {}", spill.path().display()))?;
-    let mut chunk = Chunk::default();
+    let mut chunk = RecordingChunk::default();
     loop {
         let n = r.read_chunk(&mut chunk)?;
         if n == 0 {

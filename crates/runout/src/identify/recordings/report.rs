@@ -6,7 +6,7 @@ use super::fit::{
 use super::{ChainDecision, Consistency, Extra, FileResult, RecordingsRequest, Verdicts};
 use crate::job::Report;
 use runout_core::identify::{ChainFitReport, FullSignalFit, MeanForceCalibration, SineFit};
-use runout_core::signal::{Component, ToothReference};
+use runout_core::signal::{ForceComponent, ToothReference};
 use runout_core::{FluteLead, RadiusProfile};
 use runout_io::recording::Format;
 use schemars::JsonSchema;
@@ -439,7 +439,7 @@ fn waveform(
         angle_deg: (0..avg.bins)
             .map(|j| (f.start_angle + tau * j as f64 / avg.bins as f64).to_degrees())
             .collect(),
-        measured_N: [Component::Fx, Component::Fy, Component::Fz]
+        measured_N: [ForceComponent::Fx, ForceComponent::Fy, ForceComponent::Fz]
             .map(|c| avg.component(c).mean.clone()),
         predicted_N: fit
             .as_ref()

@@ -2,7 +2,7 @@
 
 use crate::job::Source;
 use anyhow::{bail, Context, Result};
-use runout_core::signal::Component;
+use runout_core::signal::ForceComponent;
 use runout_core::{Cut, Cutter};
 use runout_io::config::identify::{identify_key_names, resolve_identify, IdentifyCase};
 use runout_io::config::{layer_from_toml, Layer, Settings};
@@ -55,7 +55,7 @@ pub struct RecordingsRequest {
     /// Section to analyse (s); `None`: the steady cut, detected.
     pub section_s: Option<(f64, f64)>,
     /// Component of the per-tooth peaks (default the resultant |F_xy|).
-    pub peak_component: Component,
+    pub peak_component: ForceComponent,
     /// Once-per-revolution (or encoder) channel.
     pub pulse_channel: Option<String>,
     /// Pulses per revolution of the pulse channel.
@@ -84,7 +84,7 @@ impl RecordingsRequest {
             axes: None,
             sample_rate_hz: None,
             section_s: None,
-            peak_component: Component::Fxy,
+            peak_component: ForceComponent::Fxy,
             pulse_channel: None,
             pulses_per_rev: 1,
             tooth0_angle_deg: None,
@@ -106,10 +106,10 @@ impl RecordingsRequest {
             _ => ChainChoice::Auto,
         };
         let peak_component = match case.peak_component.as_str() {
-            "fx" => Component::Fx,
-            "fy" => Component::Fy,
-            "fz" => Component::Fz,
-            _ => Component::Fxy,
+            "fx" => ForceComponent::Fx,
+            "fy" => ForceComponent::Fy,
+            "fz" => ForceComponent::Fz,
+            _ => ForceComponent::Fxy,
         };
         Self {
             axes: case.axes,
@@ -149,10 +149,10 @@ impl RecordingsRequest {
     /// The peak component in the config vocabulary (`fxy`, `fx`, `fy`, `fz`).
     pub(super) fn peak_component_name(&self) -> &'static str {
         match self.peak_component {
-            Component::Fx => "fx",
-            Component::Fy => "fy",
-            Component::Fz => "fz",
-            Component::Fxy => "fxy",
+            ForceComponent::Fx => "fx",
+            ForceComponent::Fy => "fy",
+            ForceComponent::Fz => "fz",
+            ForceComponent::Fxy => "fxy",
         }
     }
 }

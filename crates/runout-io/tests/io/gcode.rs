@@ -277,7 +277,7 @@ proptest! {
 /// refuses a 400-digit word (issue 20 row 10) instead of reading it as infinity.
 #[test]
 fn fuzz_crasher_many_decimals_in_incremental_mode_is_reproduced() {
-    let bytes = include_bytes!("data/fuzz_nc_many_decimals.nc");
+    let bytes = include_bytes!("../data/fuzz_nc_many_decimals.nc");
     let text = std::str::from_utf8(bytes).unwrap();
     let p = NcProgram::parse(text).unwrap();
     let none = vec![None; p.motion_blocks().len()];

@@ -3,7 +3,7 @@
 //! through the one entry point `open_recording`; clear errors for missing names.
 
 use runout_io::formats::{detect, inspect, Kind};
-use runout_io::recording::{open_recording, Chunk, Format, ReadOptions, RecordingError};
+use runout_io::recording::{open_recording, Format, ReadOptions, RecordingChunk, RecordingError};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -63,7 +63,7 @@ fn check_dir(dir: &Path) -> usize {
         assert_eq!(info.channels.len(), channels.len(), "{key}");
         let mut got: Vec<Vec<f64>> = vec![Vec::new(); channels.len()];
         let mut times = Vec::new();
-        let mut c = Chunk::default();
+        let mut c = RecordingChunk::default();
         let mut chunks = 0;
         while r
             .read_chunk(&mut c, 37)

@@ -52,7 +52,7 @@ fn table_noise_free_rows() {
             "M{m}×C{c} bilinear max {x:.3} vs {max}"
         );
         let (hr, hx) = table_row(m, c, Scheme::FirstHarmonic, &mut || 0.0);
-        // exact up to the nm-level ellipse term of the tilted section (tests/grind_interp.rs)
+        // exact up to the nm-level ellipse term of the tilted section (tests/core/grind_interp.rs)
         assert!(
             hr < 0.0005 && hx < 0.0005,
             "M{m}×C{c} harmonic {hr} / {hx} µm"

@@ -2,7 +2,7 @@
 //! give `Ok` or a clear error naming the file — never a panic, never an unbounded allocation.
 
 use proptest::prelude::*;
-use runout_io::recording::{recording_from_bytes, Chunk, ReadOptions};
+use runout_io::recording::{recording_from_bytes, ReadOptions, RecordingChunk};
 use std::path::Path;
 
 const FIXTURES: [&str; 11] = [
@@ -38,7 +38,7 @@ fn read_all(name: &str, bytes: &[u8]) {
     ] {
         match recording_from_bytes(&file, bytes, None, &opts) {
             Ok(mut r) => {
-                let mut c = Chunk::default();
+                let mut c = RecordingChunk::default();
                 let mut total = 0usize;
                 loop {
                     match r.read_chunk(&mut c, 4096) {
@@ -158,7 +158,7 @@ fn decoder_panic_is_an_error(path: &str) {
     match recording_from_bytes(name, &b, None, &ReadOptions::new().sample_rate_hz(1000.0)) {
         Err(e) => failed = e.to_string().contains(name),
         Ok(mut r) => {
-            let mut c = Chunk::default();
+            let mut c = RecordingChunk::default();
             loop {
                 match r.read_chunk(&mut c, 4096) {
                     Ok(0) => break,

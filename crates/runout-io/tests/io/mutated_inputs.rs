@@ -198,7 +198,7 @@ fn mutated(examples: &'static [&'static [u8]]) -> impl Strategy<Value = Vec<u8>>
 }
 
 /// `cases` per parser, times `MUTATED_INPUTS_FACTOR` (default 1) for a longer search:
-/// `MUTATED_INPUTS_FACTOR=50 cargo test --release -p runout-io --test mutated_inputs`.
+/// `MUTATED_INPUTS_FACTOR=50 cargo test --release -p runout-io --test io mutated_inputs::`.
 fn config(cases: u32) -> ProptestConfig {
     let factor: u32 = std::env::var("MUTATED_INPUTS_FACTOR")
         .ok()

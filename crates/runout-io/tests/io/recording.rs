@@ -3,7 +3,7 @@
 
 use proptest::prelude::*;
 use runout_io::recording::{
-    AxisMapping, Chunk, Format, ReadOptions, Recording, RecordingError, RecordingReader,
+    AxisMapping, Format, ReadOptions, Recording, RecordingChunk, RecordingError, RecordingReader,
 };
 
 /// Test signal of channel `c` at sample `k` (values with 4 decimals so text is exact enough).
@@ -112,7 +112,7 @@ fn streaming_chunks_equal_whole_read() {
     let whole = Recording::from_bytes("a", text.as_bytes(), &ReadOptions::new()).unwrap();
     let opts = ReadOptions::new().channels(&["Fz", "Fx"]);
     let mut r = RecordingReader::from_bytes("a", text.as_bytes(), &opts).unwrap();
-    let mut chunk = Chunk::default();
+    let mut chunk = RecordingChunk::default();
     let (mut fz, mut fx, mut firsts) = (Vec::new(), Vec::new(), Vec::new());
     loop {
         let n = r.read_chunk(&mut chunk, 100).unwrap();
@@ -250,7 +250,7 @@ fn axis_mapping_resolves_against_a_recording() {
     let axes = m.resolve(r.info()).unwrap();
     let chunk = r.next_chunk().unwrap().unwrap();
     let mut x = Vec::new();
-    assert!(axes.map_chunk(&chunk, runout_io::recording::Axis::X, &mut x));
+    assert!(axes.map_chunk(&chunk, runout_io::recording::FrameAxis::X, &mut x));
     assert_eq!(x[5], -value(1, 5));
     let err = AxisMapping::parse("x = Fq, y = Fx")
         .unwrap()
