@@ -136,6 +136,17 @@ fn every_command_line_in_the_readmes_runs() {
                     .env("PATH", &path)
                     .output()
                     .unwrap();
+                // issue 21 item 4: what users read has no words from the code
+                let said = format!(
+                    "{}{}",
+                    String::from_utf8_lossy(&out.stdout),
+                    String::from_utf8_lossy(&out.stderr)
+                );
+                for token in ["::", "Some(", "Ok(", "Err("] {
+                    if said.contains(token) {
+                        failures.push(format!("{name}:{line}: output contains `{token}`"));
+                    }
+                }
                 if !out.status.success() {
                     failures.push(format!(
                         "{name}:{line}: exit {:?}\n{script}\n{}",

@@ -1,7 +1,10 @@
 //! Plots of the displacement methods (methods.md §1): polar plot of the per-tooth radii with the
 //! runout vector, and runout vs height with the regression line.
 
-use crate::plot::{colour, draw_legend, e2s, legend_dot, legend_line, tooth_colour, PlotError};
+use crate::plot::{
+    colour, draw_legend, e2s, legend_dot, legend_line, polar_page_xy, tooth_colour, PlotError,
+    POLAR_CONVENTION,
+};
 use crate::{render_plot, render_svg};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -67,16 +70,16 @@ fn draw_teeth<DB: DrawingBackend>(
         .configure_mesh()
         .light_line_style(BLACK.mix(0.04))
         .x_desc(format!(
-            "spindle frame x (µm; radius = {base:.2} µm + deviation)"
+            "µm ({POLAR_CONVENTION}; radius = {base:.2} µm + deviation)"
         ))
-        .y_desc("spindle frame y (µm)")
+        .y_desc("µm")
         .draw()
         .map_err(e2s)?;
     let circle = |r: &dyn Fn(f64) -> f64| -> Vec<(f64, f64)> {
         (0..=360)
             .map(|i| {
                 let a = TAU * i as f64 / 360.0;
-                (r(a) * a.cos(), r(a) * a.sin())
+                polar_page_xy(r(a), a)
             })
             .collect()
     };
@@ -103,7 +106,7 @@ fn draw_teeth<DB: DrawingBackend>(
             .legend(|(x, y)| {
                 PathElement::new(vec![(x, y), (x + 18, y)], BLACK.mix(0.6).stroke_width(2))
             });
-        let tip = (rho * l.cos(), rho * l.sin());
+        let tip = polar_page_xy(rho, l);
         chart
             .draw_series(LineSeries::new(
                 vec![(0.0, 0.0), tip],
@@ -118,7 +121,7 @@ fn draw_teeth<DB: DrawingBackend>(
             .draw_series(std::iter::once(Circle::new(tip, 5, colour(3).filled())))
             .map_err(e2s)?;
     }
-    let pt = |a: f64, v: f64| ((base + v) * a.cos(), (base + v) * a.sin());
+    let pt = |a: f64, v: f64| polar_page_xy(base + v, a);
     chart
         .draw_series(
             d.tooth_angles_rad
@@ -128,7 +131,7 @@ fn draw_teeth<DB: DrawingBackend>(
                 .map(|(i, (a, v))| {
                     // each tooth in its colour; the label on the side towards the centre, so
                     // that no label runs off the plot
-                    let right = a.cos() > 0.2;
+                    let right = a.sin() > 0.2;
                     let mut style = TextStyle::from(("sans-serif", 14).into_font()).pos(Pos::new(
                         if right { HPos::Right } else { HPos::Left },
                         VPos::Bottom,

@@ -227,6 +227,22 @@ pub fn legend_dot(colour: RGBColor) -> impl Fn((i32, i32)) -> Circle<(i32, i32),
     move |(x, y)| Circle::new((x + 9, y), 5, colour.filled())
 }
 
+/// The one polar convention of every plot (issue 21 item 7; docs/conventions.md): the spindle
+/// frame seen from above the tool (looking down −z), tooth 0 (angle 0) up and angles positive
+/// clockwise on the page — the direction the spindle turns. Returns page (x, y) for radius `r` at
+/// spindle-frame angle `angle_rad`.
+///
+/// ```
+/// let (x, y) = runout_io::plot::polar_page_xy(1.0, 90f64.to_radians());
+/// assert!((x - 1.0).abs() < 1e-12 && y.abs() < 1e-12); // 90° in the rotation direction: right
+/// ```
+pub fn polar_page_xy(r: f64, angle_rad: f64) -> (f64, f64) {
+    (r * angle_rad.sin(), r * angle_rad.cos())
+}
+
+/// How [`polar_page_xy`] draws the spindle frame, for the plots' captions.
+pub const POLAR_CONVENTION: &str = "seen from above the tool: tooth 0 up, rotation clockwise";
+
 /// Ring spacing of a polar plot of radius `rmax`: the smallest round number (1, 2, 2.5, 5 or 10
 /// × 10ⁿ) at least rmax/4, which gives 3–6 rings.
 ///
@@ -358,4 +374,20 @@ fn draw_forces<DB: DrawingBackend>(
     }
     draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod polar_convention_tests {
+    use super::polar_page_xy;
+
+    /// Tooth 0 up; a quarter turn in the rotation direction is on the right (clockwise seen from
+    /// above, conventions.md); a quarter turn against it on the left.
+    #[test]
+    fn rotation_is_clockwise_on_the_page_with_tooth_0_up() {
+        let close =
+            |(x, y): (f64, f64), (u, v): (f64, f64)| (x - u).abs() < 1e-12 && (y - v).abs() < 1e-12;
+        assert!(close(polar_page_xy(2.0, 0.0), (0.0, 2.0)));
+        assert!(close(polar_page_xy(2.0, 90f64.to_radians()), (2.0, 0.0)));
+        assert!(close(polar_page_xy(2.0, -90f64.to_radians()), (-2.0, 0.0)));
+    }
 }

@@ -35,6 +35,7 @@ pub mod shank;
 pub mod simulate;
 pub mod spill;
 pub mod verdict;
+pub mod words;
 
 pub use job::{to_json, NoProgress, Progress, Report, Source};
 pub use runout_core as core;

@@ -85,3 +85,34 @@ pub fn without_provenance(text: &str) -> String {
         None => text.to_string(),
     }
 }
+
+/// A plot file without its provenance metadata (SVG `<metadata id="runout-provenance">` element;
+/// PNG `tEXt` chunk `runout-provenance`), for comparing the plots of two runs whose command lines
+/// differ by design.
+pub fn plot_without_provenance(path: &std::path::Path) -> Vec<u8> {
+    let bytes = std::fs::read(path).unwrap();
+    if let Ok(text) = std::str::from_utf8(&bytes) {
+        if let (Some(a), Some(b)) = (
+            text.find("\n<metadata id=\"runout-provenance\">"),
+            text.find("</metadata>"),
+        ) {
+            return [&text[..a], &text[b + "</metadata>".len()..]]
+                .concat()
+                .into_bytes();
+        }
+        return bytes;
+    }
+    // PNG: drop the tEXt chunk with the runout-provenance keyword
+    let mut out = bytes[..8.min(bytes.len())].to_vec();
+    let mut i = 8;
+    while i + 12 <= bytes.len() {
+        let n = u32::from_be_bytes(bytes[i..i + 4].try_into().unwrap()) as usize;
+        let end = (i + 12 + n).min(bytes.len());
+        let chunk = &bytes[i..end];
+        if !(&chunk[4..8] == b"tEXt" && chunk[8..].starts_with(b"runout-provenance\0")) {
+            out.extend_from_slice(chunk);
+        }
+        i = end;
+    }
+    out
+}

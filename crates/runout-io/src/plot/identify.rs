@@ -284,10 +284,14 @@ fn draw_polar<DB: DrawingBackend>(
         .build_cartesian_2d(-rmax..rmax, -rmax..rmax)
         .map_err(e2s)?;
     // Spindle frame drawn with tooth 0 up and the rotation direction clockwise on the page.
-    let to_xy = |r: f64, deg: f64| {
-        let a = deg.to_radians();
-        (r * a.sin(), r * a.cos())
-    };
+    let to_xy = |r: f64, deg: f64| super::polar_page_xy(r, deg.to_radians());
+    chart
+        .draw_series(std::iter::once(Text::new(
+            super::POLAR_CONVENTION,
+            (-rmax * 0.97, rmax * 0.97),
+            ("sans-serif", 12),
+        )))
+        .map_err(e2s)?;
     // ring spacing: a round number giving 3–6 rings
     let step = crate::plot::polar_ring_step(rmax);
     let rings = (rmax / step).floor() as usize;

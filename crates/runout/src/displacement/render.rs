@@ -60,8 +60,9 @@ pub fn teeth_text(r: &TeethReport) -> String {
         return String::new();
     };
     let mut s = format!(
-        "runout from per-tooth readings ({}; method {:?})\n",
-        r.input.file, fit.method
+        "runout from per-tooth readings ({}; method {})\n",
+        r.input.file,
+        crate::words::plain(&fit.method)
     );
     s += &match fit.offset_se_mm {
         Some(se) => format!(
@@ -74,12 +75,12 @@ pub fn teeth_text(r: &TeethReport) -> String {
     s += &angle_text(&fit.angle);
     s += "\n";
     s += &format!(
-        "residual rms {:.4} µm, dof {}, noise {} ({:?})\n",
+        "residual rms {:.4} µm, dof {}, noise {} ({})\n",
         fit.residual_rms_mm * 1e3,
         fit.dof,
         fit.noise_mm
             .map_or("unknown".into(), |n| format!("{:.4} µm", n * 1e3)),
-        fit.noise_source
+        crate::words::plain(&fit.noise_source)
     );
     for (i, (p, d)) in fit
         .positions_mm
@@ -138,8 +139,9 @@ pub fn heights_text(r: &HeightsReport) -> String {
     };
     let file = &r.input.file;
     let mut s = format!(
-        "runout vs height ({file}; {} heights, {:?})\n",
-        fit.points, fit.method
+        "runout vs height ({file}; {} heights, {})\n",
+        fit.points,
+        crate::words::plain(&fit.method)
     );
     s += &match fit.offset_se_mm {
         Some(se) => format!(
@@ -186,7 +188,11 @@ pub fn heights_plot(path: &Path, r: &HeightsReport) -> Result<()> {
     let d = HeightPlot {
         points: pts.iter().map(|(z, r)| (*z, r * 1e3)).collect(),
         line: vec![(z0, fit.at(z0) * 1e3), (z1, fit.at(z1) * 1e3)],
-        line_label: format!("{:?} fit, R² = {:.4}", fit.method, fit.r_squared),
+        line_label: format!(
+            "{} fit, R² = {:.4}",
+            crate::words::plain(&fit.method),
+            fit.r_squared
+        ),
         at: (
             fit.height_mm,
             fit.offset_mm * 1e3,
@@ -204,10 +210,10 @@ pub fn signal_text(r: &SignalReport) -> String {
     };
     let ch = &r.input.channels;
     let mut s = format!(
-        "runout from signal ({}; {} channel(s), spindle angle {:?}, {:.3} rpm, {} revolutions)\n",
+        "runout from signal ({}; {} channel(s), spindle angle from {}, {:.3} rpm, {} revolutions)\n",
         r.input.file,
         ch.len(),
-        fit.reference,
+        crate::words::plain(&fit.reference),
         fit.rpm,
         fit.revolutions
     );

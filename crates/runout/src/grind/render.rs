@@ -17,8 +17,10 @@ pub fn compensate_text(r: &CompensateReport) -> String {
     let (o_mag, o_ang, lambda) = polar_um(ax.offset);
     let _ = writeln!(
         s,
-        "runout grind compensate: {} layers, u {u0}..{u1} mm, scheme {:?}, outside range: {:?}",
-        r.grid.layers, comp.scheme, comp.range
+        "runout grind compensate: {} layers, u {u0}..{u1} mm, scheme {}, outside range: {}",
+        r.grid.layers,
+        crate::words::plain(&comp.scheme),
+        crate::words::plain(&comp.range)
     );
     for n in &r.grid.notes {
         let _ = writeln!(s, "note: {n}");

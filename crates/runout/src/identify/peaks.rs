@@ -161,10 +161,13 @@ pub fn peak_angle(
         return Ok(std::f64::consts::FRAC_PI_2);
     }
     let d = diameter_mm.ok_or_else(|| {
-        anyhow!("--diameter-mm is needed to find the peak angle in {mode:?} milling (or give --peak-immersion-deg)")
+        anyhow!("--diameter-mm is needed to find the peak angle in {} milling (or give --peak-immersion-deg)", crate::words::plain(&mode))
     })?;
     let ae = ae_mm.ok_or_else(|| {
-        anyhow!("--ae-mm is needed to find the peak angle in {mode:?} milling (or give --peak-immersion-deg)")
+        anyhow!(
+            "--ae-mm is needed to find the peak angle in {} milling (or give --peak-immersion-deg)",
+            crate::words::plain(&mode)
+        )
     })?;
     let cutter = Cutter::flat(d, teeth.max(1), 0.0)?;
     let cut = Cut::new(1000.0, fz_mm, 1.0)?.radial(ae, mode, &cutter)?;

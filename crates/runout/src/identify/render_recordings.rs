@@ -103,8 +103,8 @@ pub fn recordings_text(r: &RecordingsReport) -> String {
         for m in &c.modes {
             let _ = writeln!(
                 s,
-                "  mode on {:?}: {:.1} {} Hz, ζ {:.4} {}",
-                m.axis,
+                "  mode on {}: {:.1} {} Hz, ζ {:.4} {}",
+                crate::words::plain(&m.axis),
                 m.frequency_hz.value,
                 pm(m.frequency_hz.se, 1.0, 1),
                 m.damping.value,
