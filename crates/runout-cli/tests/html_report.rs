@@ -284,6 +284,73 @@ fn displacement_pages_and_the_comparison_of_saved_reports() {
     );
 }
 
+/// Issue 15 item 1: a saved **identify** report in `runout report`, next to a displacement one:
+/// the comparison table has both rows (holder A vs B), the identify section shows the answer with
+/// the JSON's numbers and the verdict judged again at the given tolerance.
+#[test]
+fn saved_identify_report_in_the_comparison_page() {
+    let d = tempfile::tempdir().unwrap();
+    let (_, id_json) = identify_example(d.path());
+    let teeth = d.path().join("teeth.json");
+    run(&[
+        "displacement",
+        "teeth",
+        "examples/displacement/teeth.csv",
+        "--teeth",
+        "4",
+        "--diameter-mm",
+        "10",
+        "--helix-deg",
+        "30",
+        "--json",
+        teeth.to_str().unwrap(),
+    ]);
+    let page = d.path().join("both.html");
+    run(&[
+        "report",
+        id_json.to_str().unwrap(),
+        teeth.to_str().unwrap(),
+        "--tolerance-um",
+        "20",
+        "--html",
+        page.to_str().unwrap(),
+    ]);
+    let html = std::fs::read_to_string(&page).unwrap();
+    check_document(&html);
+    let table = &html[html.find("id=\"comparison-table\"").expect("comparison")..];
+    let table = &table[..table.find("</table>").unwrap()];
+    assert_eq!(table.matches("<tr>").count(), 3, "head + 2 rows");
+    assert_eq!(
+        table
+            .matches("data-key=\"/verdict/tolerance_tir_um\" data-value=\"20.0\"")
+            .count(),
+        2
+    );
+    let json = read_json(&id_json);
+    let s = sections(&html);
+    assert!(
+        s[0].contains("The answer") && s[0].contains("identified"),
+        "{}",
+        s[0]
+    );
+    // the answer's numbers equal the JSON's (the verdict is judged again: 2ρ 15.95 µm < 20 µm)
+    let answer: Vec<(String, String)> = keyed(s[0])
+        .into_iter()
+        .filter(|(k, _)| k.starts_with("/answer/"))
+        .collect();
+    assert_eq!(answer.len(), 4, "{answer:?}");
+    for (k, v) in answer {
+        let want = json.pointer(&k).unwrap().as_f64().unwrap();
+        let shown: f64 = v.parse().unwrap();
+        assert!(
+            (shown - want).abs() <= 2.0 * f64::EPSILON * want.abs(),
+            "{k}"
+        );
+    }
+    assert!(s[0].contains("the tolerance 20.0 µm TIR (given)"));
+    assert!(s[0].contains("data-value=\"pass\""));
+}
+
 /// Headless Chromium renders the example's page: no console error, the verdict and every plot
 /// in the rendered DOM, numbers in the DOM equal to the JSON's, and a PNG screenshot.
 #[test]

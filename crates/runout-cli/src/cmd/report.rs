@@ -71,7 +71,7 @@ fn tolerance(v: &Option<String>) -> Result<Option<f64>> {
 /// Arguments of `runout report`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Saved JSON reports (`--json` of displacement, shank force, grind compensate, chip
+    /// Saved JSON reports (`--json` of identify, displacement, shank force, grind compensate, chip
     /// compare); several go into one page with a comparison table.
     #[arg(required = true)]
     pub reports: Vec<PathBuf>,

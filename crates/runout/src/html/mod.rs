@@ -334,6 +334,7 @@ pub fn sections_from_json(
             "runout.shank.force/1" => judged(typed::<shank::ForceReport>(name, v)?, tol, name)?,
             "runout.grind.compensate/1" => typed::<grind::CompensateReport>(name, v)?.section()?,
             "runout.chip.compare/1" => typed::<chip::CompareReport>(name, v)?.section()?,
+            "runout.identify.recording/2" => sections::saved_identify(&v, name, tol)?,
             other => bail!(
                 "{name}: schema `{other}` has no HTML page (expected one of: {})",
                 SCHEMAS.join(", ")
@@ -346,6 +347,7 @@ pub fn sections_from_json(
 
 /// The schemas `runout report` renders.
 pub const SCHEMAS: &[&str] = &[
+    "runout.identify.recording/2",
     "runout.displacement.teeth/1",
     "runout.displacement.heights/1",
     "runout.displacement.signal/1",

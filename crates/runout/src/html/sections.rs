@@ -789,3 +789,97 @@ impl ToSection for CompareReport {
         Ok(s)
     }
 }
+
+/// The section of a saved **identify** report (`runout report id.json …`): the identify report
+/// types are not deserialisable as a whole (they hold core types), so the saved JSON is read for
+/// what the page and the comparison need — the answer (runout ± SE, status, reasons, warnings),
+/// the set-up and the verdict (judged again at `tolerance_tir_um`). The plots are not in the JSON:
+/// the page says to use `runout identify … --html` for them.
+pub(super) fn saved_identify(
+    v: &serde_json::Value,
+    name: &str,
+    tolerance_tir_um: Option<f64>,
+) -> Result<Section> {
+    use anyhow::Context;
+    let answer = v
+        .get("answer")
+        .with_context(|| format!("{name}: no `answer` (expected runout.identify.recording/2)"))?;
+    let verdict: Option<VerdictReport> = match v.get("verdict") {
+        Some(x) if !x.is_null() => Some(
+            serde_json::from_value::<VerdictReport>(x.clone())
+                .with_context(|| format!("{name}: `verdict` is not a verdict"))?
+                .with_tolerance(tolerance_tir_um.or(x["tolerance_tir_um"].as_f64()))?,
+        ),
+        _ => None,
+    };
+    let num = |p: &str| v.pointer(p).and_then(serde_json::Value::as_f64);
+    let mut s = Section {
+        title: "Runout and cutting coefficients from force recordings".into(),
+        schema: v["schema"].as_str().unwrap_or_default().to_string(),
+        source: format!("saved report {name}"),
+        ..Section::default()
+    };
+    let files: Vec<String> = v["recordings"]
+        .as_array()
+        .map(|r| {
+            r.iter()
+                .filter_map(|x| x["file"].as_str().map(String::from))
+                .collect()
+        })
+        .unwrap_or_default();
+    s.setup = vec![
+        kv("recordings", files.join(", ")),
+        kv(
+            "cutter",
+            format!(
+                "K {}, D {} mm, helix {}°",
+                v["inputs"]["teeth"],
+                opt(num("/inputs/diameter_mm"), 3),
+                opt(num("/inputs/helix_deg"), 1)
+            ),
+        ),
+        kv("method", answer["method"].as_str().unwrap_or("–")),
+        kv("status", answer["status"].as_str().unwrap_or("–")),
+    ];
+    let r = &answer["runout"];
+    let mut rows = Vec::new();
+    if let Some(rho) = r["offset_um"].as_f64() {
+        rows.push(row(
+            "runout ρ (µm)",
+            "/answer/runout/offset_um",
+            rho,
+            Some(("/answer/runout/offset_um_se", r["offset_um_se"].as_f64())),
+            2,
+        ));
+    }
+    if let Some(l) = r["angle_deg"].as_f64() {
+        rows.push(row(
+            "angle λ (deg, from tooth 0 in the rotation direction)",
+            "/answer/runout/angle_deg",
+            l,
+            Some(("/answer/runout/angle_deg_se", r["angle_deg_se"].as_f64())),
+            1,
+        ));
+    }
+    s.tables.push(Table {
+        caption: "The answer".into(),
+        head: vec!["quantity".into(), "value".into(), "SE".into()],
+        rows,
+    });
+    for key in ["reasons", "warnings"] {
+        for w in answer[key].as_array().into_iter().flatten() {
+            if let Some(w) = w.as_str() {
+                s.warnings.push(w.to_string());
+            }
+        }
+    }
+    s.warnings.push(
+        "plots: the averaged waveforms are not in the saved JSON; run `runout identify … --html` for them"
+            .into(),
+    );
+    s.method.push(
+        "Runout and coefficients from the full-signal fit of the averaged force waveforms of all recordings jointly, through the measuring chain (methods.md §4.5–4.7); the per-tooth-peak sine fits are cross-checks (methods.md §4.2).".into(),
+    );
+    verdict_parts(&mut s, &verdict);
+    Ok(s)
+}
