@@ -504,15 +504,21 @@ pub(super) fn build(
         verdict: None,
         waveforms: files.iter().map(|f| waveform(req, f, fit, extra)).collect(),
     };
-    report.verdict = verdict_of(&report);
+    match verdict_of(&report) {
+        Ok(v) => report.verdict = v,
+        // a verdict that cannot be formed is said, not silently dropped
+        Err(e) => report.answer.warnings.push(format!("no verdict: {e:#}")),
+    }
     report
 }
 
 /// The verdict on the full-signal runout (issue 15), at the tip, for the cutter of the inputs
 /// (flat with its helix; a profiled cutter is judged by its nominal diameter) and the largest
 /// f_z of the recordings; none without a full-signal fit.
-fn verdict_of(r: &RecordingsReport) -> Option<crate::verdict::VerdictReport> {
-    let f = r.full_signal.ok()?;
+fn verdict_of(r: &RecordingsReport) -> anyhow::Result<Option<crate::verdict::VerdictReport>> {
+    let Some(f) = r.full_signal.ok() else {
+        return Ok(None);
+    };
     let fz = r
         .recordings
         .iter()
@@ -531,5 +537,5 @@ fn verdict_of(r: &RecordingsReport) -> Option<crate::verdict::VerdictReport> {
         },
         None,
     )
-    .ok()
+    .map(Some)
 }
