@@ -210,7 +210,7 @@ def identify(
     "fs": 10000.0}``); ``config``: cut.toml; ``keys``: config keys overriding it (``fz_mm`` (mm,
     one per recording), ``teeth``, ``diameter_mm``, ``helix_deg``, ``rpm``, ``ap_mm``, ``ae_mm``,
     ``mode``, ``axes``, ``sample_rate_hz`` (Hz), ``chain``, …). Returns
-    ``runout.identify.recording/1`` (the CLI's ``--json``).
+    ``runout.identify.recording/2`` (the CLI's ``--json``).
     """
 
 def identify_peaks(

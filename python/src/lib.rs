@@ -936,7 +936,7 @@ fn sources(py: Python<'_>, obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<S
 /// argument overriding the config (`fz_mm=[0.05, 0.08]` (mm, one per recording), `teeth`,
 /// `diameter_mm`, `helix_deg` (deg), `rpm`, `ap_mm`, `ae_mm`, `mode`, `axes`,
 /// `sample_rate_hz` (Hz), `chain`, …).
-/// Returns the `runout.identify.recording/1` report as a dict (`full_signal.offset_um`, …).
+/// Returns the `runout.identify.recording/2` report as a dict (`full_signal.offset_um`, …).
 #[pyfunction]
 #[pyo3(signature = (recordings, config=None, **keys))]
 fn identify<'py>(

@@ -20,7 +20,7 @@ def dynoware_arrays(path):
 
 def test_identify_equals_cli(cli):
     got = runout.identify(RECS, config=CONFIG)
-    assert got["schema"] == "runout.identify.recording/1"
+    assert got["schema"] == "runout.identify.recording/2"
     assert got == cli.json("identify", *RECS, "--config", CONFIG)
     fit = got["full_signal"]
     # the example's known runout: 8 µm at −50° (examples/identify/README.md)
