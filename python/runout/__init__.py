@@ -32,6 +32,7 @@ from ._runout import (  # noqa: F401
     shank_calibrate,
     shank_force,
     shank_stiffness,
+    simulate,
 )
 
 __all__ = [
@@ -53,4 +54,5 @@ __all__ = [
     "shank_calibrate",
     "shank_force",
     "shank_stiffness",
+    "simulate",
 ]

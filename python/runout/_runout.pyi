@@ -213,6 +213,26 @@ def identify(
     ``runout.identify.recording/2`` (the CLI's ``--json``).
     """
 
+def simulate(
+    config: Optional[SourceLike] = None,
+    *,
+    sample_rate_hz: Optional[float] = None,
+    **keys: Union[float, int, str, bool, Sequence[float], Sequence[str]],
+) -> Tuple[Report, Dict[str, np.ndarray]]:
+    """Mechanistic milling forces (N) with runout (methods.md §0, §4.1); the CLI's ``runout simulate``.
+
+    ``config``: case TOML; ``sample_rate_hz`` (Hz) sets the angular step; ``keys``: case keys
+    overriding it (``teeth``, ``diameter_mm`` (mm), ``helix_deg`` (deg), ``rpm``, ``fz_mm``,
+    ``ap_mm``, ``ae_mm`` (mm), ``mode``, ``runout_um`` (µm), ``runout_angle_deg`` (deg),
+    ``ktc``/``krc``/``kac`` (N/mm²), ``kte``/``kre``/``kae`` (N/mm), ``revolutions``, ``step_deg``
+    (deg), ``disks``, ``chip_model`` (arc | exact | equivalent), …).
+
+    Returns (``runout.simulate/1`` as the CLI's ``--json``, series): float64 arrays of one element
+    per sample — ``time_s`` (s), ``angle_deg`` (spindle angle, deg), ``fx_N``, ``fy_N``, ``fz_N``
+    (N, on the workpiece), ``torque_Nm`` (N·m) — and ``h_mm`` of shape (teeth, samples): each
+    tooth's chip thickness at the lowest disk (mm).
+    """
+
 def identify_peaks(
     peaks_N: ArrayLike,
     *,

@@ -955,6 +955,54 @@ fn identify<'py>(
     to_dict(py, &r)
 }
 
+/// Mechanistic milling forces with runout (methods.md §0 and §4.1: the forces of every tooth on
+/// every axial disk, the chip thickness by the chosen model); the CLI's `runout simulate`.
+///
+/// Args: config (case TOML source, optional), sample_rate_hz (Hz: sets the angular step to
+/// 360·rpm/(60·rate), as `--sample-rate-hz`), and any case key as a keyword argument overriding
+/// the config (`teeth`, `diameter_mm` (mm), `helix_deg` (deg), `pitch_deg` (deg, list), `rpm`,
+/// `fz_mm`, `ap_mm`, `ae_mm` (mm), `mode` (up | down | slot), `entry_deg`/`exit_deg` (deg),
+/// `runout_um` (µm), `runout_angle_deg` (deg), `tilt_um_per_mm`, `tilt_angle_deg`, `ktc`, `krc`,
+/// `kac` (N/mm²), `kte`, `kre`, `kae` (N/mm), `revolutions`, `step_deg` (deg), `disks`,
+/// `chip_model` (arc | exact | equivalent), …).
+/// Returns (report dict `runout.simulate/1` — the CLI's `--json`: inputs, tooth radii, mean
+/// forces, per-tooth peaks —, series): series is a dict of float64 arrays with one element per
+/// sample (the CLI's `--out` CSV at full precision): `time_s` (s), `angle_deg` (spindle angle
+/// θ, deg, tooth 0's tip at immersion θ), `fx_N`, `fy_N`, `fz_N` (N, on the workpiece),
+/// `torque_Nm` (N·m), and `h_mm` of shape (teeth, samples): each tooth's chip thickness at the
+/// lowest disk (mm; the CSV's `h<i>_mm`).
+#[pyfunction]
+#[pyo3(signature = (config=None, *, sample_rate_hz=None, **keys))]
+fn simulate<'py>(
+    py: Python<'py>,
+    config: Option<&Bound<'py, PyAny>>,
+    sample_rate_hz: Option<f64>,
+    keys: Option<&Bound<'py, PyDict>>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
+    let config = opt_source(py, config, "config")?;
+    let flags = layer(keys, &runout_io::config::simulate::simulate_key_names())?;
+    let r = run(py, move || {
+        let mut req = runout::simulate::SimulateRequest::from_config(config.as_ref(), flags)?;
+        req.sample_rate_hz = sample_rate_hz;
+        runout::simulate::simulate(&req)
+    })?;
+    let s = &r.detail.series;
+    let d = PyDict::new(py);
+    d.set_item("time_s", PyArray1::from_slice(py, &s.time))?;
+    d.set_item(
+        "angle_deg",
+        PyArray1::from_iter(py, s.angle.iter().map(|a| a.to_degrees())),
+    )?;
+    d.set_item("fx_N", PyArray1::from_slice(py, &s.fx))?;
+    d.set_item("fy_N", PyArray1::from_slice(py, &s.fy))?;
+    d.set_item("fz_N", PyArray1::from_slice(py, &s.fz))?;
+    d.set_item("torque_Nm", PyArray1::from_slice(py, &s.torque))?;
+    let h = numpy::PyArray2::from_vec2(py, &s.chip)
+        .map_err(|e| RunoutError::new_err(format!("simulate: chip thickness table: {e}")))?;
+    d.set_item("h_mm", h)?;
+    Ok((to_dict(py, &r)?, d))
+}
+
 fn parse_mode(mode: &str) -> PyResult<runout_core::MillingMode> {
     mode.parse()
         .map_err(|e: <runout_core::MillingMode as std::str::FromStr>::Err| {
@@ -1101,6 +1149,7 @@ fn batch<'py>(
             summary,
             threads,
             retry_errors,
+            parquet: None,
         };
         runout::batch::run(
             &req,
@@ -1131,6 +1180,7 @@ fn _runout(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(identify, m)?)?;
     m.add_function(wrap_pyfunction!(identify_peaks, m)?)?;
     m.add_function(wrap_pyfunction!(identify_tests, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(batch_row, m)?)?;
     m.add_function(wrap_pyfunction!(batch, m)?)?;
     m.add("SUMMARY_COLUMNS", runout::batch::columns())?;
