@@ -12,6 +12,10 @@
 //! * **Resumable**: files already in the summary (ok or error) are skipped; rows are appended and
 //!   flushed one by one, so an interrupted run loses at most the analyses in flight. At the end the
 //!   table is rewritten sorted by file (atomically: temporary file + rename).
+//! * **Parquet** (cargo feature `parquet`): the same table, same columns, typed (numbers as
+//!   nullable `DOUBLE`, text as UTF-8), written atomically at the end next to the CSV
+//!   ([`BatchRequest::parquet`], [`write_summary_parquet`]). The CSV stays the table a run resumes
+//!   from.
 //!
 //! The analysis is a closure ([`run`]), so the framework is tested without a recording format;
 //! `runout batch` plugs in the identify job.
@@ -88,6 +92,14 @@ pub struct BatchRequest {
     pub threads: Option<usize>,
     /// Analyse again the files whose row in the summary is an error.
     pub retry_errors: bool,
+    /// Also write the final summary as Parquet to this file (needs the `parquet` feature; an
+    /// error naming the feature without it). [`parquet_next_to`] gives the usual name.
+    pub parquet: Option<PathBuf>,
+}
+
+/// The Parquet summary next to the CSV one: `summary.csv` → `summary.parquet`.
+pub fn parquet_next_to(summary: &Path) -> PathBuf {
+    summary.with_extension("parquet")
 }
 
 /// `runout.batch/1`: what a batch run did.
@@ -201,6 +213,110 @@ pub fn write_summary(w: impl std::io::Write, rows: &[Row]) -> Result<()> {
     }
     w.flush()?;
     Ok(())
+}
+
+/// The summary as Parquet columns: the CSV's columns in the same order ([`columns`]), the
+/// [`TEXT_COLUMNS`] as UTF-8 text, every other one as a nullable 64-bit float (null where the
+/// CSV cell is empty).
+#[cfg(feature = "parquet")]
+pub fn summary_table(
+    rows: &[Row],
+) -> Result<Vec<(String, runout_io::formats::parquet::TableColumn)>> {
+    use runout_io::formats::parquet::TableColumn;
+    let values: Vec<serde_json::Map<String, serde_json::Value>> = rows
+        .iter()
+        .map(|r| match serde_json::to_value(r)? {
+            serde_json::Value::Object(m) => Ok(m),
+            _ => unreachable!("a row is a struct"),
+        })
+        .collect::<Result<_, serde_json::Error>>()?;
+    let mut table = Vec::new();
+    for name in columns() {
+        let cell = |m: &serde_json::Map<String, serde_json::Value>| m.get(&name).cloned();
+        let col = if TEXT_COLUMNS.contains(&name.as_str()) {
+            TableColumn::Text(
+                values
+                    .iter()
+                    .map(|m| {
+                        cell(m)
+                            .and_then(|v| v.as_str().map(String::from))
+                            .unwrap_or_default()
+                    })
+                    .collect(),
+            )
+        } else {
+            TableColumn::Float(
+                values
+                    .iter()
+                    .map(|m| cell(m).and_then(|v| v.as_f64()))
+                    .collect(),
+            )
+        };
+        table.push((name, col));
+    }
+    Ok(table)
+}
+
+/// Write `rows` as the Parquet summary to `path`, atomically (temporary file + rename).
+#[cfg(feature = "parquet")]
+pub fn write_summary_parquet(path: &Path, rows: &[Row]) -> Result<()> {
+    let table = summary_table(rows)?;
+    let tmp = tmp_next_to(path);
+    let out = std::fs::File::create(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
+    runout_io::formats::parquet::write_table(
+        std::io::BufWriter::new(out),
+        &table,
+        &path.display().to_string(),
+    )?;
+    std::fs::rename(&tmp, path).with_context(|| format!("replacing {}", path.display()))?;
+    Ok(())
+}
+
+/// Without the `parquet` feature: an error saying how to get it.
+#[cfg(not(feature = "parquet"))]
+pub fn write_summary_parquet(path: &Path, _rows: &[Row]) -> Result<()> {
+    bail!(
+        "{}: this build has no Parquet support (build with `--features parquet`)",
+        path.display()
+    )
+}
+
+/// The rows of a Parquet summary ([`write_summary_parquet`]).
+#[cfg(feature = "parquet")]
+pub fn read_summary_parquet(path: &Path) -> Result<Vec<Row>> {
+    use runout_io::formats::parquet::TableColumn;
+    let table = runout_io::formats::parquet::read_table(path)?;
+    let want = columns();
+    let names: Vec<&str> = table.iter().map(|(n, _)| n.as_str()).collect();
+    if names != want {
+        bail!(
+            "{}: not a batch summary: columns {} (expected {})",
+            path.display(),
+            names.join(", "),
+            want.join(", ")
+        );
+    }
+    let n = match table.first() {
+        Some((_, TableColumn::Text(v))) => v.len(),
+        Some((_, TableColumn::Float(v))) => v.len(),
+        None => 0,
+    };
+    let mut rows = Vec::with_capacity(n);
+    for i in 0..n {
+        let mut m = serde_json::Map::new();
+        for (name, col) in &table {
+            let v = match col {
+                TableColumn::Text(v) => serde_json::Value::from(v[i].clone()),
+                TableColumn::Float(v) => v[i].map_or(serde_json::Value::Null, Into::into),
+            };
+            m.insert(name.clone(), v);
+        }
+        rows.push(
+            serde_json::from_value(serde_json::Value::Object(m))
+                .with_context(|| format!("{}: row {}", path.display(), i + 1))?,
+        );
+    }
+    Ok(rows)
 }
 
 /// The summary row of an identify report (`runout.identify.recording/1`, as JSON): ρ, λ and the
@@ -386,6 +502,17 @@ where
     F: Fn(&Path) -> Result<Row> + Sync,
 {
     let start = Instant::now();
+    if let Some(p) = &req.parquet {
+        if !cfg!(feature = "parquet") {
+            write_summary_parquet(p, &[])?; // the error naming the feature
+        }
+        if p == &req.summary {
+            bail!(
+                "{}: the Parquet summary cannot be the CSV summary",
+                p.display()
+            );
+        }
+    }
     let mut existing = read_summary(&req.summary)?;
     if req.retry_errors {
         existing.retain(|r| r.status != "error");
@@ -462,6 +589,9 @@ where
         .with_context(|| format!("writing {}", tmp.display()))?;
     std::fs::rename(&tmp, &req.summary)
         .with_context(|| format!("replacing {}", req.summary.display()))?;
+    if let Some(p) = &req.parquet {
+        write_summary_parquet(p, &all)?;
+    }
     Ok(BatchReport {
         schema: BatchReport::SCHEMA.into(),
         summary: req.summary.display().to_string(),

@@ -36,5 +36,6 @@ pub fn all() -> Vec<(&'static str, String, String)> {
         one::<crate::identify::RecordingsReport>(),
         one::<crate::simulate::SimulateReport>(),
         one::<crate::inspect::InspectReport>(),
+        one::<crate::batch::BatchReport>(),
     ]
 }

@@ -60,6 +60,7 @@ fn every_file_once_errors_listed_resumable() {
         summary: summary.clone(),
         threads: Some(2),
         retry_errors: false,
+        parquet: None,
     };
     let seen = Mutex::new(0usize);
     let report = batch::run(&req, counted, &|_| *seen.lock().unwrap() += 1).unwrap();
@@ -126,6 +127,7 @@ fn an_interrupted_run_resumes_where_it_stopped() {
         summary: summary.clone(),
         threads: Some(1),
         retry_errors: false,
+        parquet: None,
     };
     batch::run(&req, analyse, &|_| {}).unwrap();
     let text = std::fs::read_to_string(&summary).unwrap();
@@ -168,6 +170,7 @@ fn bad_requests_are_errors() {
         summary: summary.clone(),
         threads: None,
         retry_errors: false,
+        parquet: None,
     };
     let e = format!("{:#}", batch::run(&req, analyse, &|_| {}).unwrap_err());
     assert!(e.contains("s.csv:2") && e.contains("batch summary"), "{e}");
@@ -210,4 +213,115 @@ fn identify_row_equals_the_identify_report() {
     assert_eq!(row.status, "error");
     assert!(row.error.contains("bad.txt"), "{}", row.error);
     assert_eq!(row.time, "");
+}
+
+/// Without the `parquet` feature, asking for a Parquet summary is an error naming the feature,
+/// before any recording is analysed.
+#[test]
+#[cfg(not(feature = "parquet"))]
+fn parquet_without_the_feature_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let (files, _) = make(dir.path(), 3);
+    let calls = AtomicUsize::new(0);
+    let req = BatchRequest {
+        files,
+        summary: dir.path().join("s.csv"),
+        threads: Some(1),
+        retry_errors: false,
+        parquet: Some(dir.path().join("s.parquet")),
+    };
+    let counted = |p: &Path| {
+        calls.fetch_add(1, Ordering::SeqCst);
+        analyse(p)
+    };
+    let e = format!("{:#}", batch::run(&req, counted, &|_| {}).unwrap_err());
+    assert!(
+        e.contains("s.parquet") && e.contains("--features parquet"),
+        "{e}"
+    );
+    assert_eq!(calls.load(Ordering::SeqCst), 0);
+    assert!(!req.summary.exists());
+}
+
+/// With the `parquet` feature: the Parquet summary holds the CSV's rows (read back equal, field
+/// for field: the floats are the same f64, written as DOUBLE), same columns in the same order,
+/// numbers typed as DOUBLE with nulls where the CSV is empty, text as UTF-8; it is rewritten on a
+/// resumed run, and the CSV alone is what a run resumes from.
+#[test]
+#[cfg(feature = "parquet")]
+fn parquet_summary_equals_the_csv() {
+    use runout::io::formats::parquet::{read_table, TableColumn};
+    let dir = tempfile::tempdir().unwrap();
+    let (files, bad) = make(dir.path(), 40);
+    let summary = dir.path().join("s.csv");
+    let parquet = batch::parquet_next_to(&summary);
+    assert_eq!(parquet, dir.path().join("s.parquet"));
+    let req = BatchRequest {
+        files: files[..30].to_vec(),
+        summary: summary.clone(),
+        threads: Some(2),
+        retry_errors: false,
+        parquet: Some(parquet.clone()),
+    };
+    batch::run(&req, analyse, &|_| {}).unwrap();
+    let rows = batch::read_summary(&summary).unwrap();
+    assert_eq!(rows.len(), 30);
+    assert_eq!(batch::read_summary_parquet(&parquet).unwrap(), rows);
+    // typed columns, the CSV's order
+    let table = read_table(&parquet).unwrap();
+    let names: Vec<String> = table.iter().map(|(n, _)| n.clone()).collect();
+    assert_eq!(names, batch::columns());
+    for (name, col) in &table {
+        let text = batch::TEXT_COLUMNS.contains(&name.as_str());
+        assert_eq!(matches!(col, TableColumn::Text(_)), text, "{name}");
+    }
+    let (_, TableColumn::Float(ktc)) = &table[8] else {
+        panic!("ktc is a float column")
+    };
+    assert_eq!(table[8].0, "ktc_N_per_mm2");
+    assert!(
+        ktc.iter().all(Option::is_none),
+        "not given by the stand-in: null"
+    );
+    let (_, TableColumn::Float(offset)) = &table[4] else {
+        panic!("offset is a float column")
+    };
+    let errors = rows.iter().filter(|r| r.status == "error").count();
+    assert!(errors > 0);
+    assert_eq!(offset.iter().filter(|x| x.is_none()).count(), errors);
+    // resumed over all 40: the Parquet file is rewritten with every row; the CSV drives the skip
+    let calls = AtomicUsize::new(0);
+    let counted = |p: &Path| {
+        calls.fetch_add(1, Ordering::SeqCst);
+        analyse(p)
+    };
+    let all = BatchRequest {
+        files: files.clone(),
+        ..req.clone()
+    };
+    let report = batch::run(&all, counted, &|_| {}).unwrap();
+    assert_eq!((report.skipped, report.analysed), (30, 10));
+    assert_eq!(calls.load(Ordering::SeqCst), 10);
+    let rows = batch::read_summary(&summary).unwrap();
+    assert_eq!(rows.len(), 40);
+    assert_eq!(
+        rows.iter().filter(|r| r.status == "error").count(),
+        bad,
+        "every bad file a row"
+    );
+    assert_eq!(batch::read_summary_parquet(&parquet).unwrap(), rows);
+    // no temporary file left next to them
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+    // the same path for both is refused
+    let same = BatchRequest {
+        parquet: Some(summary.clone()),
+        ..req
+    };
+    let e = format!("{:#}", batch::run(&same, analyse, &|_| {}).unwrap_err());
+    assert!(e.contains("cannot be the CSV summary"), "{e}");
 }

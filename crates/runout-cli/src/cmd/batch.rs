@@ -21,6 +21,11 @@ pub struct Args {
     /// finish, rewritten sorted by file at the end.
     #[arg(long, default_value = "runout-summary.csv")]
     pub summary: PathBuf,
+    /// The summary also as Parquet (same columns; numbers as DOUBLE, text as UTF-8), written
+    /// atomically at the end. Default: the summary's name with `.parquet`, in a build with the
+    /// `parquet` feature (none without it).
+    #[arg(long, value_name = "FILE")]
+    pub parquet: Option<PathBuf>,
     /// Worker threads (recordings analysed at once); default the number of cores.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -81,7 +86,14 @@ pub fn run(a: Args) -> Result<()> {
     for spec in &a.inputs {
         files.extend(batch::expand(spec)?);
     }
-    for out in [Some(&a.summary), a.json.as_ref()].into_iter().flatten() {
+    let parquet = a
+        .parquet
+        .clone()
+        .or_else(|| cfg!(feature = "parquet").then(|| batch::parquet_next_to(&a.summary)));
+    for out in [Some(&a.summary), a.json.as_ref(), parquet.as_ref()]
+        .into_iter()
+        .flatten()
+    {
         if files.iter().any(|f| crate::output::same_file(out, f))
             || crate::output::same_file(out, &a.config)
         {
@@ -94,6 +106,7 @@ pub fn run(a: Args) -> Result<()> {
         summary: a.summary.clone(),
         threads: a.threads,
         retry_errors: a.retry_errors,
+        parquet,
     };
     let report = batch::run(
         &req,

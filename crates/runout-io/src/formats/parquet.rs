@@ -286,3 +286,117 @@ impl ChunkReader for SharedFile {
         self.0.as_ref().get_bytes(start, length)
     }
 }
+
+/// A typed column of a table written as Parquet ([`write_table`]): 64-bit floats (nullable:
+/// `None` is a null, e.g. a value not available) or UTF-8 text.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TableColumn {
+    /// Parquet `DOUBLE` (Arrow `Float64`), nullable.
+    Float(Vec<Option<f64>>),
+    /// Parquet `BYTE_ARRAY` UTF-8 (Arrow `Utf8`), not null.
+    Text(Vec<String>),
+}
+
+impl TableColumn {
+    fn len(&self) -> usize {
+        match self {
+            TableColumn::Float(v) => v.len(),
+            TableColumn::Text(v) => v.len(),
+        }
+    }
+}
+
+/// Write a table of named, typed columns (all the same length) as one Parquet file (one row
+/// group, snappy-compressed), e.g. the batch summary. `file` names the output in messages.
+pub fn write_table<W: std::io::Write + Send>(
+    w: W,
+    columns: &[(String, TableColumn)],
+    file: &str,
+) -> std::result::Result<(), RecordingError> {
+    use arrow_array::{Float64Array, RecordBatch, StringArray};
+    use parquet::arrow::ArrowWriter;
+    use parquet::basic::Compression;
+    use parquet::file::properties::WriterProperties;
+    use std::sync::Arc;
+    let rows = columns.first().map(|(_, c)| c.len()).unwrap_or(0);
+    if let Some((name, _)) = columns.iter().find(|(_, c)| c.len() != rows) {
+        return Err(perr(
+            file,
+            format!("column `{name}` has a different length than the first ({rows} rows)"),
+        ));
+    }
+    let arrays = columns.iter().map(|(name, c)| {
+        let (a, nullable): (ArrayRef, bool) = match c {
+            TableColumn::Float(v) => (Arc::new(Float64Array::from(v.clone())), true),
+            TableColumn::Text(v) => (Arc::new(StringArray::from(v.clone())), false),
+        };
+        (name.as_str(), a, nullable)
+    });
+    let batch = RecordBatch::try_from_iter_with_nullable(arrays).map_err(|e| perr(file, e))?;
+    let props = WriterProperties::builder()
+        .set_compression(Compression::SNAPPY)
+        .build();
+    let mut writer =
+        ArrowWriter::try_new(w, batch.schema(), Some(props)).map_err(|e| perr(file, e))?;
+    writer.write(&batch).map_err(|e| perr(file, e))?;
+    writer.close().map_err(|e| perr(file, e))?;
+    Ok(())
+}
+
+/// Read a table written by [`write_table`] (or any Parquet file of top-level `DOUBLE` and UTF-8
+/// columns): the columns in file order. Another column type is an error naming it.
+pub fn read_table(path: &Path) -> std::result::Result<Vec<(String, TableColumn)>, RecordingError> {
+    use arrow_array::{Float64Array, StringArray};
+    let file = path.display().to_string();
+    let f = std::fs::File::open(path).map_err(|error| RecordingError::Io {
+        file: file.clone(),
+        error,
+    })?;
+    guard(&file, || {
+        let reader = ParquetRecordBatchReaderBuilder::try_new(f)
+            .and_then(|b| b.build())
+            .map_err(|e| perr(&file, e))?;
+        let mut out: Vec<(String, TableColumn)> = reader
+            .schema()
+            .fields()
+            .iter()
+            .map(|fl| {
+                let empty = if fl.data_type().is_numeric() {
+                    TableColumn::Float(Vec::new())
+                } else {
+                    TableColumn::Text(Vec::new())
+                };
+                (fl.name().clone(), empty)
+            })
+            .collect();
+        for batch in reader {
+            let batch = batch.map_err(|e| perr(&file, e))?;
+            for ((name, col), a) in out.iter_mut().zip(batch.columns()) {
+                match col {
+                    TableColumn::Float(v) => {
+                        let a = a.as_any().downcast_ref::<Float64Array>().ok_or_else(|| {
+                            perr(
+                                &file,
+                                format!("column `{name}`: expected DOUBLE, got {}", a.data_type()),
+                            )
+                        })?;
+                        v.extend(a.iter());
+                    }
+                    TableColumn::Text(v) => {
+                        let a = a.as_any().downcast_ref::<StringArray>().ok_or_else(|| {
+                            perr(
+                                &file,
+                                format!(
+                                    "column `{name}`: expected UTF-8 text, got {}",
+                                    a.data_type()
+                                ),
+                            )
+                        })?;
+                        v.extend(a.iter().map(|s| s.unwrap_or_default().to_string()));
+                    }
+                }
+            }
+        }
+        Ok(out)
+    })
+}
