@@ -62,8 +62,8 @@ pub struct ChipCaseSpec {
     /// Spindle speed (rpm).
     pub rpm: f64,
     /// Spindle rotation seen from above: cw | ccw.
-    #[serde(default = "default_spindle")]
-    pub spindle: String,
+    #[serde(default)]
+    pub spindle: Spindle,
     /// Feed per tooth (mm) for straight, circular and swing motion.
     #[serde(default)]
     pub fz_mm: Option<f64>,
@@ -79,9 +79,9 @@ pub struct ChipCaseSpec {
     /// Tilt direction (deg, spindle frame).
     #[serde(default)]
     pub tilt_angle_deg: f64,
-    /// Motion: straight | circular | swing | path.
-    #[serde(default = "default_motion")]
-    pub motion: String,
+    /// Motion: straight | circular | swing | path | joints.
+    #[serde(default)]
+    pub motion: MotionKind,
     /// Swing axis (workpiece frame), for `swing`.
     #[serde(default)]
     pub swing_axis: Option<[f64; 3]>,
@@ -124,11 +124,45 @@ pub struct ChipCaseSpec {
 fn default_profile() -> String {
     "flat".into()
 }
-fn default_spindle() -> String {
-    "cw".into()
+/// `spindle = cw | ccw`: the spindle's rotation seen from above.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Spindle {
+    /// Clockwise.
+    #[default]
+    Cw,
+    /// Counter-clockwise.
+    Ccw,
 }
-fn default_motion() -> String {
-    "straight".into()
+
+/// `motion = straight | circular | swing | path | joints`: how the tool moves in a case.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MotionKind {
+    /// Straight feed along x (`fz_mm`).
+    #[default]
+    Straight,
+    /// Circular path (`path_radius_mm`, `path_ccw`).
+    Circular,
+    /// Straight feed with a constant swing of the tool axis (`swing_axis`, `swing_deg_s`).
+    Swing,
+    /// A CL toolpath file (`toolpath`).
+    Path,
+    /// Machine joints of a head-head A/C machine without RTCP (`joints`).
+    Joints,
+}
+
+impl MotionKind {
+    /// The word as written in a case file.
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionKind::Straight => "straight",
+            MotionKind::Circular => "circular",
+            MotionKind::Swing => "swing",
+            MotionKind::Path => "path",
+            MotionKind::Joints => "joints",
+        }
+    }
 }
 fn default_true() -> bool {
     true
@@ -186,6 +220,22 @@ pub struct ChipCase {
     pub warnings: Vec<String>,
 }
 
+/// `key = "word"` of `t` checked against the vocabulary `T` (exactly, as serde reads it): an
+/// unknown word is `key `k`: unknown variant …, expected …`.
+fn word_key<T: serde::de::DeserializeOwned>(t: &toml::Table, key: &str) -> Result<(), String> {
+    use serde::de::value::{Error, StrDeserializer};
+    use serde::de::IntoDeserializer;
+    match t.get(key) {
+        Some(toml::Value::String(w)) => {
+            let d: StrDeserializer<'_, Error> = w.as_str().into_deserializer();
+            T::deserialize(d)
+                .map(|_| ())
+                .map_err(|e| format!("key `{key}`: {}", super::clip_quoted(&e.to_string())))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Parse the case specs of a case-set file (defaults merged).
 pub fn parse_case_specs(file: &str, text: &str) -> Result<Vec<ChipCaseSpec>, ChipConfigError> {
     let perr = |message: String| ChipConfigError::Parse {
@@ -222,6 +272,10 @@ pub fn parse_case_specs(file: &str, text: &str) -> Result<Vec<ChipCaseSpec>, Chi
             };
             let mut merged = defaults.clone();
             merged.extend(t);
+            // the words first, so that an unknown one is named with its key
+            word_key::<MotionKind>(&merged, "motion")
+                .and_then(|_| word_key::<Spindle>(&merged, "spindle"))
+                .map_err(|m| perr(format!("case {}: {m}", n + 1)))?;
             toml::Value::Table(merged)
                 .try_into::<ChipCaseSpec>()
                 .map_err(|e| {
@@ -313,12 +367,12 @@ fn motion_of(s: &ChipCaseSpec, base: &Path) -> Result<(Motion, Vec<String>), Str
         limits::feed_mm_min("feed_mm_min", f).map_err(|e| e.to_string())?;
     }
     let along_x = |v: f64| Vec3::new(v, 0.0, 0.0);
-    Ok(match s.motion.as_str() {
-        "straight" => (
+    Ok(match s.motion {
+        MotionKind::Straight => (
             Motion::Straight(StraightFeed::along_x(feed_speed(s)?)),
             vec![],
         ),
-        "circular" => {
+        MotionKind::Circular => {
             let r = s
                 .path_radius_mm
                 .ok_or("path_radius_mm: required for circular")?;
@@ -326,7 +380,7 @@ fn motion_of(s: &ChipCaseSpec, base: &Path) -> Result<(Motion, Vec<String>), Str
                 .map_err(|e| e.to_string())?;
             (Motion::Circular(c), vec![])
         }
-        "swing" => {
+        MotionKind::Swing => {
             let a = s.swing_axis.ok_or("swing_axis: required for swing")?;
             let w = ConstantSwing::new(
                 along_x(feed_speed(s)?),
@@ -337,7 +391,7 @@ fn motion_of(s: &ChipCaseSpec, base: &Path) -> Result<(Motion, Vec<String>), Str
             .map_err(|e| e.to_string())?;
             (Motion::Swing(w), vec![])
         }
-        "path" => {
+        MotionKind::Path => {
             let file = s.toolpath.as_ref().ok_or("toolpath: required for path")?;
             let full = base.join(file);
             let mut tp = read_toolpath(&full).map_err(|e| e.to_string())?;
@@ -348,7 +402,7 @@ fn motion_of(s: &ChipCaseSpec, base: &Path) -> Result<(Motion, Vec<String>), Str
             let path = ClPath::new(&cl).map_err(|e| format!("{name}: {e}"))?;
             (Motion::Path(path), tp.warnings)
         }
-        "joints" => {
+        MotionKind::Joints => {
             let file = s
                 .joints
                 .as_ref()
@@ -360,11 +414,6 @@ fn motion_of(s: &ChipCaseSpec, base: &Path) -> Result<(Motion, Vec<String>), Str
             let pts = joint_points(&name, &blocks, s.feed_mm_min).map_err(|e| e.to_string())?;
             let path = JointPath::new(&pts, s.pivot_mm).map_err(|e| format!("{name}: {e}"))?;
             (Motion::Joints(path), vec![])
-        }
-        o => {
-            return Err(format!(
-                "motion: expected straight, circular, swing, path or joints, got `{o}`"
-            ))
         }
     })
 }
@@ -382,10 +431,9 @@ pub fn resolve_case(
     };
     let cutter = cutter_of(&spec).map_err(err)?;
     let runout = runout_of(&spec, &cutter).map_err(err)?;
-    let sense = match spec.spindle.as_str() {
-        "cw" => SpindleSense::Clockwise,
-        "ccw" => SpindleSense::CounterClockwise,
-        o => return Err(err(format!("spindle: expected cw or ccw, got `{o}`"))),
+    let sense = match spec.spindle {
+        Spindle::Cw => SpindleSense::Clockwise,
+        Spindle::Ccw => SpindleSense::CounterClockwise,
     };
     let (motion, warnings) = motion_of(&spec, base).map_err(err)?;
     let duration = match &motion {

@@ -151,8 +151,8 @@ pub struct IdentifyCase {
     pub sample_rate_hz: Option<f64>,
     /// Section override (s).
     pub section_s: Option<(f64, f64)>,
-    /// Peak component name.
-    pub peak_component: String,
+    /// Component of the per-tooth peaks.
+    pub peak_component: PeakComponent,
     /// Pulse channel name.
     pub pulse_channel: Option<String>,
     /// Pulses per revolution.
@@ -161,14 +161,48 @@ pub struct IdentifyCase {
     pub tooth0_angle: Option<f64>,
     /// Fit the tilt too.
     pub fit_tilt: bool,
-    /// Measuring chain: auto | rigid | modes | frf | band.
-    pub chain: String,
+    /// Measuring chain.
+    pub chain: Chain,
     /// Measured FRF file.
     pub sensor_frf: Option<String>,
     /// Start values of the fitted modes' natural frequencies (Hz): one, or per axis x, y[, z].
     pub sensor_mode_hz: Option<Vec<f64>>,
     /// Band limit (highest spindle harmonic).
     pub max_harmonic: Option<usize>,
+}
+
+/// `peak_component = fxy | fx | fy | fz`: the force component whose per-tooth peaks are fitted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PeakComponent {
+    /// Resultant |F_xy| (N).
+    #[default]
+    Fxy,
+    /// F_x (N).
+    Fx,
+    /// F_y (N).
+    Fy,
+    /// F_z (N).
+    Fz,
+}
+
+/// `chain = auto | rigid | modes | frf | band`: how the measuring chain (the dynamometer's own
+/// dynamics) is modelled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Chain {
+    /// Fit one second-order mode per axis and use it where it explains the waveform
+    /// significantly better.
+    #[default]
+    Auto,
+    /// No sensor dynamics.
+    Rigid,
+    /// Always the fitted modes.
+    Modes,
+    /// The measured FRF of `sensor_frf`.
+    Frf,
+    /// Only the spindle harmonics up to `max_harmonic` (rigid).
+    Band,
 }
 
 fn per_recording(s: &Settings, key: &str, n: usize) -> Result<Vec<f64>, ConfigError> {
@@ -221,17 +255,7 @@ pub fn resolve_identify(s: &Settings, recordings: usize) -> Result<IdentifyCase,
             Some((a, b))
         }
     };
-    let peak_component = s
-        .text("peak_component")?
-        .unwrap_or_else(|| "fxy".into())
-        .to_ascii_lowercase();
-    if !["fxy", "fx", "fy", "fz"].contains(&peak_component.as_str()) {
-        return Err(ConfigError::Key {
-            source_name: s.origin("peak_component").unwrap_or("config").into(),
-            key: "peak_component".into(),
-            message: format!("expected fxy, fx, fy or fz, got `{peak_component}`"),
-        });
-    }
+    let peak_component: PeakComponent = s.choice("peak_component")?.unwrap_or_default();
     let fit_tilt = match s
         .text("fit_tilt")?
         .as_deref()
@@ -250,26 +274,18 @@ pub fn resolve_identify(s: &Settings, recordings: usize) -> Result<IdentifyCase,
     };
     let sensor_frf = s.text("sensor_frf")?;
     let max_harmonic = s.count("max_harmonic")?;
-    let chain = match s.text("chain")?.map(|c| c.to_ascii_lowercase()) {
+    let chain = match s.choice::<Chain>("chain")? {
         Some(c) => c,
-        None if sensor_frf.is_some() => "frf".into(),
-        None if max_harmonic.is_some() => "band".into(),
-        None => "auto".into(),
+        None if sensor_frf.is_some() => Chain::Frf,
+        None if max_harmonic.is_some() => Chain::Band,
+        None => Chain::Auto,
     };
-    let chain_error = |message: String| ConfigError::Key {
-        source_name: s.origin("chain").unwrap_or("config").into(),
-        key: "chain".into(),
-        message,
-    };
-    if !["auto", "rigid", "modes", "frf", "band"].contains(&chain.as_str()) {
-        return Err(chain_error(format!(
-            "expected auto, rigid, modes, frf or band, got `{chain}`"
-        )));
-    }
-    if chain == "frf" && sensor_frf.is_none() {
-        return Err(chain_error(
-            "chain = frf needs sensor_frf (--sensor-frf FILE)".into(),
-        ));
+    if chain == Chain::Frf && sensor_frf.is_none() {
+        return Err(ConfigError::Key {
+            source_name: s.origin("chain").unwrap_or("config").into(),
+            key: "chain".into(),
+            message: "chain = frf needs sensor_frf (--sensor-frf FILE)".into(),
+        });
     }
     let sensor_mode_hz = s.list("sensor_mode_hz", Quantity::FrequencyHz)?;
     if let Some(v) = &sensor_mode_hz {

@@ -185,21 +185,19 @@ impl Settings {
     }
 
     /// A word naming one variant of the serde enum `T` (`snake_case` names, e.g. `chip_model =
-    /// "exact"`), or `None` when unset; an unknown word is an error listing the accepted ones.
+    /// "exact"`; [`word`]), or `None` when unset; an unknown word is an error naming the key and
+    /// where it was set, and listing the accepted words.
     pub fn choice<T: serde::de::DeserializeOwned>(
         &self,
         key: &str,
     ) -> Result<Option<T>, ConfigError> {
-        use serde::de::IntoDeserializer;
         let Some(t) = self.text(key)? else {
             return Ok(None);
         };
-        let d: serde::de::value::StrDeserializer<'_, serde::de::value::Error> =
-            t.trim().into_deserializer();
-        T::deserialize(d).map(Some).map_err(|e| ConfigError::Key {
+        word(&t).map(Some).map_err(|message| ConfigError::Key {
             source_name: self.origin(key).unwrap_or("config").into(),
             key: key.into(),
-            message: clip_quoted(&e.to_string()),
+            message,
         })
     }
 
@@ -233,7 +231,8 @@ impl Settings {
     }
 }
 
-/// A TOML error as `line L, column C: message`, without the source snippet the parser's own
+/// A TOML error as `line L, column C[, key `k`]: message` (the key when the error points at
+/// a value, e.g. an unknown word), without the source snippet the parser's own
 /// display adds (which would echo a whole long line) and with every `quoted` part of the
 /// message clipped to 80 characters.
 pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
@@ -241,11 +240,19 @@ pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
     match e.span().and_then(|s| text.get(..s.start)) {
         Some(before) => {
             let line = before.matches('\n').count() + 1;
-            let col = before[before.rfind('\n').map_or(0, |i| i + 1)..]
-                .chars()
-                .count()
-                + 1;
-            format!("TOML parse error at line {line}, column {col}: {msg}")
+            let this_line = &before[before.rfind('\n').map_or(0, |i| i + 1)..];
+            let col = this_line.chars().count() + 1;
+            // the key whose value is wrong (`axis = "z"`), when the error points at a value
+            let key = this_line
+                .split_once('=')
+                .map(|(k, _)| k.trim().trim_matches('"'))
+                .filter(|k| !k.is_empty() && !k.contains(char::is_whitespace));
+            match key {
+                Some(k) => {
+                    format!("TOML parse error at line {line}, column {col}, key `{k}`: {msg}")
+                }
+                None => format!("TOML parse error at line {line}, column {col}: {msg}"),
+            }
         }
         None => format!("TOML parse error: {msg}"),
     }
@@ -376,10 +383,57 @@ pub fn layer_from_toml(file: &str, text: &str, known: &[&str]) -> Result<Layer, 
     })
 }
 
+/// One word of a closed vocabulary as the serde enum `T` (unit variants, e.g.
+/// `rename_all = "snake_case"`): surrounding spaces ignored, case-insensitive. An unknown word
+/// is an error listing the accepted ones (serde's `unknown variant `x`, expected one of `a`,
+/// `b``, quoted parts clipped).
+///
+/// ```
+/// use runout_io::config::{word, ProfileKind};
+/// assert_eq!(word::<ProfileKind>(" Bull_Nose ").unwrap(), ProfileKind::BullNose);
+/// let e = word::<ProfileKind>("round").unwrap_err();
+/// assert!(e.contains("`round`") && e.contains("`flat`, `ball`, `bull_nose`, `tapered`"), "{e}");
+/// ```
+pub fn word<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, String> {
+    use serde::de::value::{Error, StrDeserializer};
+    use serde::de::IntoDeserializer;
+    let t = text.trim();
+    let as_is: StrDeserializer<'_, Error> = t.into_deserializer();
+    T::deserialize(as_is).or_else(|e| {
+        let lower = t.to_ascii_lowercase();
+        let d: StrDeserializer<'_, Error> = lower.as_str().into_deserializer();
+        T::deserialize(d).map_err(|_| clip_quoted(&e.to_string()))
+    })
+}
+
 /// The end-profile vocabulary shared by every command that describes a cutter (`simulate`,
 /// `identify`, `chip`): `profile = flat | ball | bull_nose | tapered`, with `corner_radius_mm`
 /// (bull nose only) and `taper_deg` (tapered only).
-pub const PROFILES: &[&str] = &["flat", "ball", "bull_nose", "tapered"];
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProfileKind {
+    /// Flat end.
+    #[default]
+    Flat,
+    /// Ball end (radius D/2).
+    Ball,
+    /// Bull nose (corner radius `corner_radius_mm`).
+    BullNose,
+    /// Tapered (half-cone angle `taper_deg`).
+    Tapered,
+}
+
+impl ProfileKind {
+    /// The word as written in a config.
+    pub fn name(self) -> &'static str {
+        match self {
+            ProfileKind::Flat => "flat",
+            ProfileKind::Ball => "ball",
+            ProfileKind::BullNose => "bull_nose",
+            ProfileKind::Tapered => "tapered",
+        }
+    }
+}
 
 /// Resolve `profile`, `corner_radius_mm` and `taper_deg` into a [`runout_core::RadiusProfile`]
 /// for a cutter of `diameter_mm`. Errors are `(key, message)`: a bad combination names the
@@ -402,20 +456,12 @@ pub fn radius_profile(
     taper_deg: Option<f64>,
 ) -> Result<runout_core::RadiusProfile, (String, String)> {
     use runout_core::RadiusProfile;
-    let name = name.trim().to_ascii_lowercase();
     let r = diameter_mm / 2.0;
     let err = |k: &str, m: String| Err((k.to_string(), m));
-    if !PROFILES.contains(&name.as_str()) {
-        return err(
-            "profile",
-            format!(
-                "expected one of flat, ball, bull_nose, tapered, got `{}`",
-                clip_quoted(&name)
-            ),
-        );
-    }
+    let kind: ProfileKind = word(name).map_err(|m| ("profile".to_string(), m))?;
+    let name = kind.name();
     if let Some(c) = corner_radius_mm {
-        if name != "bull_nose" {
+        if kind != ProfileKind::BullNose {
             return err(
                 "corner_radius_mm",
                 format!(
@@ -425,7 +471,7 @@ pub fn radius_profile(
         }
     }
     if let Some(t) = taper_deg {
-        if name != "tapered" {
+        if kind != ProfileKind::Tapered {
             return err(
                 "taper_deg",
                 format!(
@@ -434,10 +480,10 @@ pub fn radius_profile(
             );
         }
     }
-    match name.as_str() {
-        "flat" => Ok(RadiusProfile::Flat),
-        "ball" => Ok(RadiusProfile::Ball),
-        "bull_nose" => {
+    match kind {
+        ProfileKind::Flat => Ok(RadiusProfile::Flat),
+        ProfileKind::Ball => Ok(RadiusProfile::Ball),
+        ProfileKind::BullNose => {
             let Some(c) = corner_radius_mm else {
                 return err(
                     "corner_radius_mm",
@@ -452,7 +498,7 @@ pub fn radius_profile(
             }
             Ok(RadiusProfile::BullNose { corner_mm: c })
         }
-        _ => {
+        ProfileKind::Tapered => {
             let Some(t) = taper_deg else {
                 return err(
                     "taper_deg",

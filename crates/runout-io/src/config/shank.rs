@@ -88,6 +88,38 @@ pub struct DynamicsSection {
     pub deconvolution_floor: Option<f64>,
 }
 
+/// `load_point = "tip" | "mid-depth"`: where the cutting force acts on the shank beam.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum LoadPointWord {
+    /// At the tool tip (l_tool).
+    #[serde(rename = "tip")]
+    Tip,
+    /// At mid axial depth (l_tool − a_p/2; needs `axial_depth_mm`).
+    #[serde(rename = "mid-depth")]
+    MidDepth,
+}
+
+/// `axis = "x" | "y"` of a `[[pair]]` (upper case accepted).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum PairAxisWord {
+    /// x: the feed direction.
+    #[serde(rename = "x", alias = "X")]
+    X,
+    /// y: feed-normal.
+    #[serde(rename = "y", alias = "Y")]
+    Y,
+}
+
+impl PairAxisWord {
+    /// `x` or `y`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PairAxisWord::X => "x",
+            PairAxisWord::Y => "y",
+        }
+    }
+}
+
 /// `[shank]`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -102,8 +134,8 @@ pub struct BeamSection {
     pub l1_mm: Value,
     /// Sensor II height (mm).
     pub l2_mm: Value,
-    /// `tip` or `mid-depth`.
-    pub load_point: Option<String>,
+    /// Where the cutting force acts (default the tip).
+    pub load_point: Option<LoadPointWord>,
     /// Axial depth of cut (mm).
     pub axial_depth_mm: Option<Value>,
     /// Holder rotational stiffness (N·m/rad).
@@ -132,8 +164,8 @@ pub struct SpindleSection {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PairSection {
-    /// `x` or `y`.
-    pub axis: String,
+    /// `x` (feed) or `y` (feed-normal).
+    pub axis: PairAxisWord,
     /// Channel of sensor I (at l1_mm).
     #[serde(rename = "sensor_I")]
     pub sensor_i: String,

@@ -141,7 +141,7 @@ pub fn eval(req: &EvalRequest) -> Result<EvalReport> {
         schema: EvalReport::SCHEMA.into(),
         case: case.name.clone(),
         model: req.model.name().into(),
-        motion: s.motion.clone(),
+        motion: s.motion.name().into(),
         teeth: s.teeth,
         diameter_mm: s.diameter_mm,
         rpm: s.rpm,

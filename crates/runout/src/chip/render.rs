@@ -88,7 +88,7 @@ pub fn eval_text(r: &EvalReport) -> String {
         "runout chip eval: case `{}`, model {}, motion {}, {} points ({} teeth × {} heights × {} times)\n",
         case.name,
         r.model,
-        case.spec.motion,
+        case.spec.motion.name(),
         h.len(),
         teeth,
         case.spec.heights_mm.len(),

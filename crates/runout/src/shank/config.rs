@@ -3,7 +3,7 @@
 use crate::job::Source;
 use anyhow::{bail, Context, Result};
 use runout_core::shank::{LoadPoint, PairAxis, SensorPair, ShankBeam, ShankSetup};
-use runout_io::config::shank::{number, ShankConfig};
+use runout_io::config::shank::{number, LoadPointWord, PairAxisWord, ShankConfig};
 use runout_io::recording::{
     AxisMapping, ReadOptions, RecordingError, RecordingInfo, RecordingReader,
 };
@@ -46,15 +46,14 @@ pub(crate) fn load_config(config: &Source, rate: Option<f64>) -> Result<Resolved
         .as_ref()
         .map(|v| n("axial_depth_mm", v, Quantity::LengthMm))
         .transpose()?;
-    match b.load_point.as_deref() {
-        None | Some("tip") => {}
-        Some("mid-depth") => {
+    match b.load_point {
+        None | Some(LoadPointWord::Tip) => {}
+        Some(LoadPointWord::MidDepth) => {
             let Some(ap) = ap else {
                 bail!("{file}: load_point = \"mid-depth\" needs axial_depth_mm");
             };
             beam = beam.with_load_point(LoadPoint::MidDepth { axial_depth_mm: ap })?;
         }
-        Some(o) => bail!("{file}: load_point = `{o}`: expected \"tip\" or \"mid-depth\""),
     }
     if let Some(k) = &b.holder_stiffness_nm_per_rad {
         let k =
@@ -102,12 +101,9 @@ pub(crate) fn load_config(config: &Source, rate: Option<f64>) -> Result<Resolved
     }
     let mut pairs = Vec::new();
     for p in &cfg.pair {
-        let axis = match p.axis.trim() {
-            "x" | "X" => PairAxis::X,
-            "y" | "Y" => PairAxis::Y,
-            o => {
-                bail!("{file}: [[pair]] axis = `{o}`: expected \"x\" (feed) or \"y\" (feed-normal)")
-            }
+        let axis = match p.axis {
+            PairAxisWord::X => PairAxis::X,
+            PairAxisWord::Y => PairAxis::Y,
         };
         if p.sign != 1.0 && p.sign != -1.0 {
             bail!("{file}: [[pair]] sign = {}: expected 1 or -1", p.sign);

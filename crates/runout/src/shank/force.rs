@@ -657,7 +657,7 @@ fn summary(
             .pair
             .iter()
             .map(|p| PairReport {
-                axis: p.axis.clone(),
+                axis: p.axis.name().into(),
                 sensor_I: p.sensor_i.clone(),
                 sensor_II: p.sensor_ii.clone(),
                 sign: p.sign,

@@ -3,6 +3,7 @@
 //! → [`runout::identify::recordings`] → JSON, text ([`runout::identify::recordings_text`]) and
 //! plots ([`super::plots`]).
 
+use crate::flags::{CutterFlags, PlotFormat};
 use crate::output;
 use anyhow::{bail, Context, Result};
 use runout::identify::{self, recordings_text};
@@ -20,27 +21,9 @@ pub struct RecordingArgs {
     /// Cut description (TOML) with the keys of the flags below.
     #[arg(long)]
     pub config: Option<PathBuf>,
-    /// Number of teeth K.
-    #[arg(long)]
-    pub teeth: Option<String>,
-    /// Cutter diameter D (mm).
-    #[arg(long)]
-    pub diameter_mm: Option<String>,
-    /// Helix angle (deg).
-    #[arg(long)]
-    pub helix_deg: Option<String>,
-    /// End profile: flat | ball | bull_nose | tapered (default flat).
-    #[arg(long, allow_hyphen_values = true)]
-    pub profile: Option<String>,
-    /// Corner radius r_c of a bull_nose cutter (mm), 0 < r_c <= D/2.
-    #[arg(long, allow_hyphen_values = true)]
-    pub corner_radius_mm: Option<String>,
-    /// Taper (half-cone) angle of a tapered cutter (deg), 0 < α < 45; D is the tip diameter.
-    #[arg(long, allow_hyphen_values = true)]
-    pub taper_deg: Option<String>,
-    /// Flute winding on a ball, bull-nose or taper: constant_lead | constant_helix (default constant_lead).
-    #[arg(long, allow_hyphen_values = true)]
-    pub flute_lead: Option<String>,
+    /// The cutter (the flags of every command that takes one; `crate::flags::CutterFlags`).
+    #[command(flatten)]
+    pub cutter: CutterFlags,
     /// Nominal spindle speed (rpm); the actual speed is measured from the signal.
     #[arg(long)]
     pub rpm: Option<String>,
@@ -102,27 +85,20 @@ pub struct RecordingArgs {
     /// Directory for the plots (created if missing): waveform overlay, per-tooth peaks, polar runout.
     #[arg(long)]
     pub plot_dir: Option<PathBuf>,
-    /// Plot format: svg | png.
-    #[arg(long, default_value = "svg")]
-    pub plot_format: String,
+    /// Plot file type (svg or png; no unit).
+    #[arg(long, value_enum, default_value_t = PlotFormat::Svg)]
+    pub plot_format: PlotFormat,
     #[command(flatten)]
     pub report: crate::cmd::report::ReportFlags,
 }
 
 impl RecordingArgs {
     fn layer(&self) -> Layer {
-        let pairs: [(&str, &Option<String>); 23] = [
+        let pairs: [(&str, &Option<String>); 16] = [
             ("chain", &self.chain),
             ("sensor_frf", &self.sensor_frf),
             ("sensor_mode_hz", &self.sensor_mode_hz),
             ("max_harmonic", &self.max_harmonic),
-            ("teeth", &self.teeth),
-            ("diameter_mm", &self.diameter_mm),
-            ("helix_deg", &self.helix_deg),
-            ("profile", &self.profile),
-            ("corner_radius_mm", &self.corner_radius_mm),
-            ("taper_deg", &self.taper_deg),
-            ("flute_lead", &self.flute_lead),
             ("rpm", &self.rpm),
             ("fz_mm", &self.fz_mm),
             ("ap_mm", &self.ap_mm),
@@ -136,17 +112,13 @@ impl RecordingArgs {
             ("pulse_channel", &self.pulse_channel),
             ("tooth0_angle_deg", &self.tooth0_angle_deg),
         ];
-        let mut values: std::collections::BTreeMap<String, Value> = pairs
-            .into_iter()
-            .filter_map(|(k, v)| v.as_ref().map(|v| (k.to_string(), Value::Text(v.clone()))))
-            .collect();
+        let mut layer = runout::case::flag_layer(self.cutter.pairs().into_iter().chain(pairs));
         if self.fit_tilt {
-            values.insert("fit_tilt".into(), Value::Text("true".into()));
+            layer
+                .values
+                .insert("fit_tilt".into(), Value::Text("true".into()));
         }
-        Layer {
-            origin: "command line".into(),
-            values,
-        }
+        layer
     }
 }
 
@@ -167,10 +139,7 @@ pub fn run(a: RecordingArgs) -> Result<()> {
     if let Some(j) = &a.json {
         output::check_not_input(j, &inputs)?;
     }
-    let ext = match a.plot_format.as_str() {
-        "svg" | "png" => a.plot_format.as_str(),
-        other => bail!("--plot-format: expected svg or png, got `{other}`"),
-    };
+    let ext = a.plot_format.ext();
     let mut report = identify::recordings(&req, &mut crate::progress::Bars::default())?;
     a.report.judge(&mut report)?;
     a.report.write(&report)?;

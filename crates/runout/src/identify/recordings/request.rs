@@ -98,18 +98,19 @@ impl RecordingsRequest {
     /// The request of a resolved config case (the FRF file, if any, named relative to the
     /// working directory as given).
     pub fn from_case(recordings: Vec<Source>, case: IdentifyCase) -> Self {
-        let chain = match case.chain.as_str() {
-            "rigid" => ChainChoice::Rigid,
-            "modes" => ChainChoice::Modes,
-            "frf" => ChainChoice::Frf(Source::path(case.sensor_frf.unwrap_or_default())),
-            "band" => ChainChoice::Band(case.max_harmonic),
-            _ => ChainChoice::Auto,
+        use runout_io::config::identify::{Chain, PeakComponent};
+        let chain = match case.chain {
+            Chain::Auto => ChainChoice::Auto,
+            Chain::Rigid => ChainChoice::Rigid,
+            Chain::Modes => ChainChoice::Modes,
+            Chain::Frf => ChainChoice::Frf(Source::path(case.sensor_frf.unwrap_or_default())),
+            Chain::Band => ChainChoice::Band(case.max_harmonic),
         };
-        let peak_component = match case.peak_component.as_str() {
-            "fx" => ForceComponent::Fx,
-            "fy" => ForceComponent::Fy,
-            "fz" => ForceComponent::Fz,
-            _ => ForceComponent::Fxy,
+        let peak_component = match case.peak_component {
+            PeakComponent::Fxy => ForceComponent::Fxy,
+            PeakComponent::Fx => ForceComponent::Fx,
+            PeakComponent::Fy => ForceComponent::Fy,
+            PeakComponent::Fz => ForceComponent::Fz,
         };
         Self {
             axes: case.axes,
