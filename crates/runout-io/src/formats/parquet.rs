@@ -346,7 +346,7 @@ pub fn write_table<W: std::io::Write + Send>(
 /// Read a table written by [`write_table`] (or any Parquet file of top-level `DOUBLE` and UTF-8
 /// columns): the columns in file order. Another column type is an error naming it.
 pub fn read_table(path: &Path) -> std::result::Result<Vec<(String, TableColumn)>, RecordingError> {
-    use arrow_array::{Float64Array, StringArray};
+    use arrow_array::{Float64Array, RecordBatchReader, StringArray};
     let file = path.display().to_string();
     let f = std::fs::File::open(path).map_err(|error| RecordingError::Io {
         file: file.clone(),
