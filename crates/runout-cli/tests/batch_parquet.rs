@@ -99,7 +99,8 @@ for i, row in enumerate(rows):
         else:
             assert got == float(cell), (name, got, cell)
             checked += 1
-assert checked >= 20, checked
+# the ok row's rho, lambda, the coefficients with their SEs and the fit quality
+assert checked >= 15, checked
 print("ok", checked)
 "#;
     let out = std::process::Command::new("python3")
