@@ -3,7 +3,7 @@
 //! pyarrow (an independent reader) in the ignored test that `.ci/run` runs. Without the feature,
 //! `--parquet FILE` is refused with a message naming the feature.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 mod common;
 use common::*;
@@ -27,7 +27,7 @@ fn batch(dir: &Path, extra: &[&str]) -> std::process::Output {
 }
 
 #[cfg(feature = "parquet")]
-fn summaries() -> (tempfile::TempDir, PathBuf, PathBuf) {
+fn summaries() -> (tempfile::TempDir, std::path::PathBuf, std::path::PathBuf) {
     let d = tempfile::tempdir().unwrap();
     let out = batch(d.path(), &[]);
     assert!(

@@ -56,7 +56,7 @@ fn identify_words_from_flags_and_files() {
         &[
             "--profile (key `profile`)",
             "`round`",
-            "`flat`, `ball`, `bull_nose`, `tapered`",
+            "flat, ball, bull_nose, tapered",
         ],
     );
     // words are case-insensitive, as before

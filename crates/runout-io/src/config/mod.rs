@@ -424,6 +424,14 @@ pub enum ProfileKind {
 }
 
 impl ProfileKind {
+    /// Every profile, in the order messages list them.
+    pub const ALL: [ProfileKind; 4] = [
+        ProfileKind::Flat,
+        ProfileKind::Ball,
+        ProfileKind::BullNose,
+        ProfileKind::Tapered,
+    ];
+
     /// The word as written in a config.
     pub fn name(self) -> &'static str {
         match self {
@@ -458,7 +466,17 @@ pub fn radius_profile(
     use runout_core::RadiusProfile;
     let r = diameter_mm / 2.0;
     let err = |k: &str, m: String| Err((k.to_string(), m));
-    let kind: ProfileKind = word(name).map_err(|m| ("profile".to_string(), m))?;
+    let kind: ProfileKind = word(name).map_err(|_| {
+        let names: Vec<&str> = ProfileKind::ALL.iter().map(|k| k.name()).collect();
+        (
+            "profile".to_string(),
+            format!(
+                "expected one of {}, got `{}`",
+                names.join(", "),
+                clip_quoted(name.trim())
+            ),
+        )
+    })?;
     let name = kind.name();
     if let Some(c) = corner_radius_mm {
         if kind != ProfileKind::BullNose {
