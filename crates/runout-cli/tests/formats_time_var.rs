@@ -276,6 +276,8 @@ fn identify_args(file: &Path) -> Vec<String> {
         file.display().to_string(),
         "--config".into(),
         example("identify/cut.toml").display().to_string(),
+        "--fz-mm".into(),
+        "0.05".into(),
     ]
 }
 
@@ -436,4 +438,40 @@ fn displacement_signal_from_independent_writers_is_identical() {
     ]);
     let v = json_of(&SIGNAL, &dir.path().join("signal_matrix.h5"), &flags);
     assert_eq!(v, reference, "signal_matrix.h5 differs from the CSV");
+}
+
+/// `runout inspect` shows struct-array fields, cells and the columns of 2-D datasets.
+#[test]
+fn inspect_shows_struct_fields_cells_and_matrix_columns() {
+    let fx = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../runout-io/tests/fixtures");
+    for (f, wants) in [
+        (
+            "mat5_cells.mat",
+            &["s(2).Fy", "c{2}", "c{3}", "char array, not a channel"][..],
+        ),
+        (
+            "matrix.h5",
+            &[
+                "/data[:,0]",
+                "/data/Fz",
+                "column 2 of the 200×3 dataset",
+                "/dataT[:,2]",
+            ][..],
+        ),
+        (
+            "mat73_matrix.mat",
+            &["s.Fx", "M(:,2)", "column 2 of the 2×200 dataset"][..],
+        ),
+    ] {
+        let out = runout().arg("inspect").arg(fx.join(f)).output().unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{f}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for w in wants {
+            assert!(text.contains(w), "{f}: `{w}` not in\n{text}");
+        }
+    }
 }
