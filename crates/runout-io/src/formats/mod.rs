@@ -204,6 +204,35 @@ pub fn recording_from_bytes<'a>(
     ))
 }
 
+/// Like [`recording_from_bytes`], as a reader of one type for text and binary content alike,
+/// not borrowing `bytes` (a binary file is decoded or indexed at open; text is copied once into
+/// the reader). For sources held in memory by a front end (`runout::Source::bytes`).
+pub fn recording_from_shared(
+    name: &str,
+    bytes: std::sync::Arc<[u8]>,
+    selector: Option<&str>,
+    options: &ReadOptions,
+) -> Result<RecordingReader<Box<dyn std::io::BufRead + Send>>> {
+    let n = bytes.len() as u64;
+    let kind = detect(&bytes);
+    if kind == Kind::Text {
+        if let Some(sel) = selector {
+            return Err(RecordingError::Format {
+                file: name.into(),
+                message: format!(
+                    "a selector (`:{sel}`) applies to .mat, TDMS, HDF5 and Parquet files, not to text recordings"
+                ),
+            });
+        }
+        let src: Box<dyn std::io::BufRead + Send> = Box::new(std::io::Cursor::new(bytes));
+        return Ok(RecordingReader::from_reader(src, name, options)?.with_file_bytes(Some(n)));
+    }
+    let opened = open_bytes(kind, &bytes, name)?;
+    let rec = BinaryRecording::new(opened, name, selector, options, Some(n))?;
+    let empty: Box<dyn std::io::BufRead + Send> = Box::new(std::io::Cursor::new(Vec::new()));
+    Ok(RecordingReader::from_binary(empty, rec))
+}
+
 fn unsupported(kind: Kind, file: &str) -> RecordingError {
     RecordingError::Format {
         file: file.into(),
