@@ -127,7 +127,7 @@ pub fn read_signal_with<'a>(
 enum Rows<'a> {
     Text {
         file: String,
-        reader: RecordingReader<Box<dyn BufRead + 'a>>,
+        reader: Box<RecordingReader<Box<dyn BufRead + 'a>>>,
     },
     Binary {
         file: String,
@@ -231,7 +231,10 @@ fn open<'a>(input: TableInput<'a>, options: &SignalOptions) -> Result<Rows<'a>, 
         std::io::Cursor::new(head).chain(rest),
     ));
     let reader = RecordingReader::table_from_reader(src, &file).map_err(recording_error)?;
-    Ok(Rows::Text { file, reader })
+    Ok(Rows::Text {
+        file,
+        reader: Box::new(reader),
+    })
 }
 
 /// Name the channels of a binary recording from its catalog, then open it with them.

@@ -571,7 +571,7 @@ impl BinaryRecording {
             rate_var,
             &options.time_column,
         ) {
-            if !(((v - f) / f).abs() <= 1e-9) {
+            if ((v - f) / f).abs().is_nan() || ((v - f) / f).abs() > 1e-9 {
                 return Err(RecordingError::Format {
                     file: file.into(),
                     message: format!(
@@ -784,7 +784,7 @@ impl BinaryRecording {
         for (k, &t) in times.iter().enumerate() {
             let sample = self.sample + k as u64;
             let expected = t0 + sample as f64 / fs;
-            if !((t - expected).abs() <= 0.5 / fs) {
+            if t.is_nan() || (t - expected).abs() > 0.5 / fs {
                 return Err(RecordingError::Format {
                     file: self.info.file.clone(),
                     message: format!(

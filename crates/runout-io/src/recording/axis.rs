@@ -215,6 +215,26 @@ impl ResolvedAxes {
     }
 }
 
+/// Split a mapping into entries at `,` or `;` outside brackets (`D[:,1]`, `M(:,2)`, `c{1}` stay
+/// whole).
+pub(crate) fn split_entries(text: &str) -> Vec<&str> {
+    let mut out = Vec::new();
+    let (mut depth, mut start) = (0i32, 0);
+    for (i, ch) in text.char_indices() {
+        match ch {
+            '[' | '(' | '{' => depth += 1,
+            ']' | ')' | '}' => depth = (depth - 1).max(0),
+            ',' | ';' if depth == 0 => {
+                out.push(&text[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    out.push(&text[start..]);
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -248,24 +268,4 @@ mod tests {
         assert!(AxisMapping::identity_for(&["ch1", "ch2", "ch3"]).is_err());
         assert!(AxisMapping::identity_for(&["Fx", "Fz"]).is_err());
     }
-}
-
-/// Split a mapping into entries at `,` or `;` outside brackets (`D[:,1]`, `M(:,2)`, `c{1}` stay
-/// whole).
-pub(crate) fn split_entries(text: &str) -> Vec<&str> {
-    let mut out = Vec::new();
-    let (mut depth, mut start) = (0i32, 0);
-    for (i, ch) in text.char_indices() {
-        match ch {
-            '[' | '(' | '{' => depth += 1,
-            ']' | ')' | '}' => depth = (depth - 1).max(0),
-            ',' | ';' if depth == 0 => {
-                out.push(&text[start..i]);
-                start = i + 1;
-            }
-            _ => {}
-        }
-    }
-    out.push(&text[start..]);
-    out
 }
