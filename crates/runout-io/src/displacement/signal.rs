@@ -263,29 +263,24 @@ fn binary<'a>(
             )
         })
         .collect();
-    let roles = binary_roles(&names, &file, options)?;
+    let columns: Vec<Channel> = names.iter().map(|(_, c)| c.clone()).collect();
+    let r = roles(&file, &columns, options, false)?;
     let mut ro = ReadOptions::new();
     ro.sample_rate_hz = options.sample_rate_hz;
     ro.time_column = options.time_var.clone();
-    ro.channels = Some(roles);
+    if let Some(t) = &r.time {
+        // a `time_<unit>` channel is the time base (converted and checked here, ¼ step, also
+        // against --sample-rate-hz): the reader takes it as its time vector, whatever its unit
+        ro.time_column = Some(names[t.index].0.clone());
+        ro.sample_rate_hz = None;
+    }
+    ro.channels = Some(r.order.iter().map(|&i| names[i].0.clone()).collect());
     let rec = BinaryRecording::new(opened, &file, selector, &ro, bytes).map_err(recording_error)?;
     Ok(Rows::Binary {
         file,
         rec: Box::new(rec),
         names,
     })
-}
-
-/// The arrays a binary signal reads (by alias), in the order the plan indexes them: time (if a
-/// time channel), displacement channels, pulse, encoder.
-fn binary_roles(
-    names: &[(String, Channel)],
-    file: &str,
-    options: &SignalOptions,
-) -> Result<Vec<String>, TableError> {
-    let columns: Vec<Channel> = names.iter().map(|(_, c)| c.clone()).collect();
-    let r = roles(file, &columns, options, false)?;
-    Ok(r.order.iter().map(|&i| names[i].0.clone()).collect())
 }
 
 /// One channel's role: index in the delivered values, unit factor, names.

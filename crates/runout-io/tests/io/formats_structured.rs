@@ -153,7 +153,12 @@ fn displacement_signal_from_a_matrix_by_mapping() {
     assert!(e.contains("c{1}") && e.contains("[um]"), "{e}");
 }
 
-const SIGNAL_FIXTURES: [&str; 3] = ["matrix.h5", "mat5_cells.mat", "mat73_matrix.mat"];
+const SIGNAL_FIXTURES: [&str; 4] = [
+    "matrix.h5",
+    "mat5_cells.mat",
+    "mat73_matrix.mat",
+    "signal_ms.h5",
+];
 
 proptest! {
     #![proptest_config(ProptestConfig {
@@ -179,8 +184,8 @@ proptest! {
             let n = cut.index(b.len());
             b.truncate(n.max(1));
         }
-        for map in ["a = data/Fx [um], pulse = dataT[:,0]", "a = c{1} [mm], b = s(2).Fy [um]", "a = M(:,2) [um], b = s.Fx [um]"] {
-            let opts = SignalOptions { channels: Some(map.into()), time_var: None, sample_rate_hz: Some(1000.0) };
+        for map in [Some("a = data/Fx [um], pulse = dataT[:,0]"), Some("a = c{1} [mm], b = s(2).Fy [um]"), Some("a = M(:,2) [um], b = s.Fx [um]"), None] {
+            let opts = SignalOptions { channels: map.map(str::to_string), time_var: None, sample_rate_hz: map.map(|_| 1000.0) };
             let r = read_signal_with(
                 TableInput::Reader { name: "mutated-input", reader: Box::new(&b[..]), len: Some(b.len() as u64) },
                 &SignalSection::default(),
@@ -192,4 +197,39 @@ proptest! {
             }
         }
     }
+}
+
+/// A binary signal whose `time_<unit>` channel is not in seconds: converted, and the grid and a
+/// given rate checked on the converted times.
+#[test]
+fn displacement_signal_with_times_in_ms_from_hdf5() {
+    let p = fixture("signal_ms.h5");
+    let t = read_signal_with(&p, &SignalSection::default(), &SignalOptions::default()).unwrap();
+    assert!(
+        (t.sample_rate_hz - 20_000.0).abs() < 1e-6,
+        "{}",
+        t.sample_rate_hz
+    );
+    assert_eq!(t.channels[0].0, "a");
+    assert_eq!(t.channels[0].1.len(), 400);
+    assert!((t.channels[0].1[0] - 0.008).abs() < 1e-15); // 8 µm in mm
+    let agree = SignalOptions {
+        sample_rate_hz: Some(20_000.0),
+        ..Default::default()
+    };
+    assert_eq!(
+        read_signal_with(&p, &SignalSection::default(), &agree).unwrap(),
+        t
+    );
+    let disagree = SignalOptions {
+        sample_rate_hz: Some(21_000.0),
+        ..Default::default()
+    };
+    let e = read_signal_with(&p, &SignalSection::default(), &disagree)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("signal_ms.h5") && e.contains("sample ") && e.contains("--sample-rate-hz"),
+        "{e}"
+    );
 }
