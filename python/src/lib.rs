@@ -476,6 +476,7 @@ fn displacement_signal<'py>(
             to_s,
             ..Default::default()
         },
+        read: Default::default(),
         sensor_angles_rad: sensor_angles_deg.map(|v| v.into_iter().map(f64::to_radians).collect()),
         sensor: self::sensor(sensor, inclination_deg, beam_offset_mm)?,
         reference: choice(

@@ -65,6 +65,18 @@ impl PlotFlags {
     }
 }
 
+/// `--time-var NAME`: the time base of a recording from a channel / variable of the file (issue 16),
+/// for every command that reads recordings (identify, displacement signal, shank force / calibrate).
+#[derive(clap::Args, Debug, Default, Clone)]
+pub struct TimeFlags {
+    /// Channel / variable holding the sample times (s; a text column's unit from its name or
+    /// unit row), or in a .mat/HDF5/TDMS/Parquet file a scalar sample rate (Hz). The times must be
+    /// evenly spaced (every sample within ½ sample period of the grid; ¼ for displacement
+    /// signal); with --sample-rate-hz both must agree. Missing: the error lists what the file holds.
+    #[arg(long, value_name = "NAME", allow_hyphen_values = true)]
+    pub time_var: Option<String>,
+}
+
 /// The cutter: one set of flags for every command that takes one (issue 13 item 7), the keys
 /// of a case file (`teeth`, `diameter_mm`, …), resolved by one resolver
 /// ([`runout_io::config::simulate::resolve_cutter`]). Values may carry a unit suffix.

@@ -86,6 +86,8 @@ pub struct ForceArgs {
     /// Sample rate (Hz) when the file has no time column; overrides the config.
     #[arg(long, allow_hyphen_values = true)]
     sample_rate_hz: Option<String>,
+    #[command(flatten)]
+    time: crate::flags::TimeFlags,
     /// Write the force/deflection time series: `.csv` (text) or `.bin` (binary layout
     /// runout.binary/1, see --binary-type); `-` = CSV to stdout.
     #[arg(long)]
@@ -207,6 +209,7 @@ fn force(a: ForceArgs) -> Result<()> {
         a.sample_rate_hz.as_deref(),
         Quantity::FrequencyHz,
     )?;
+    req.time_var = a.time.time_var.clone();
     req.reparse = a.reparse;
     let html = a.report.html.clone();
     for out in [&a.out, &a.json, &html].into_iter().flatten() {

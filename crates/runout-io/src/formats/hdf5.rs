@@ -3,7 +3,14 @@
 //!
 //! Channels are numeric datasets of one dimension, or two with one of them 1 (MATLAB stores a
 //! 1×N vector as an N×1 dataset); the channel name is the dataset path (`/grp/Fx`; in a v7.3
-//! file `rec.Fx`, as MATLAB names a struct field). Attributes `fs` / `sample_rate_hz` (on the
+//! file `rec.Fx`, as MATLAB names a struct field, a group of the file).
+//!
+//! A 2-D dataset holds one channel per column: the longer dimension is the samples (N×C as
+//! numpy / pandas write it, or C×N as MATLAB v7.3 stores an N×C matrix). Column `k` is named
+//! `/grp/D[:,k]` (0-based, numpy style; in a v7.3 file `M(:,j)`, 1-based as in MATLAB); with a
+//! column-name attribute (`columns`, `column_names`, `channel_names` or `names`: one name per
+//! column) the columns are also channels `/grp/D/NAME`, so the dataset works as a group
+//! (`FILE:D` selects its columns by name). Attributes `fs` / `sample_rate_hz` (on the
 //! dataset, its group or the root) give the sample rate, `unit` / `units` the unit. Integer and
 //! float element types of 1–8 bytes are converted to f64.
 //!
@@ -53,6 +60,33 @@ enum Layout {
     Vector,
     Column,
     Row,
+    /// Column `k` of an N×C dataset.
+    ColumnOf(u64),
+    /// Row `k` of a C×N dataset.
+    RowOf(u64),
+}
+
+/// Attributes naming the columns of a 2-D dataset.
+const COLUMN_NAMES: [&str; 4] = ["columns", "column_names", "channel_names", "names"];
+
+fn attr_names(attrs: &[hdf5_reader::Attribute]) -> Option<Vec<String>> {
+    let a = attrs
+        .iter()
+        .find(|a| COLUMN_NAMES.iter().any(|n| a.name.eq_ignore_ascii_case(n)))?;
+    let v = match a.read_strings() {
+        Ok(v) if v.len() > 1 => v,
+        _ => a
+            .read_string()
+            .ok()?
+            .split(',')
+            .map(str::to_string)
+            .collect(),
+    };
+    Some(
+        v.into_iter()
+            .map(|s| s.trim_end_matches('\0').trim().to_string())
+            .collect(),
+    )
 }
 
 struct Walk<'a> {
@@ -131,11 +165,32 @@ impl Walk<'_> {
             ),
             other => (false, format!("{other:?}").chars().take(40).collect()),
         };
+        // a MATLAB char / cell / struct … stored as numbers is not a channel
+        let class_ok = attr_text(&attrs, &["MATLAB_class"]).is_none_or(|c| {
+            matches!(
+                c.as_str(),
+                "double"
+                    | "single"
+                    | "int8"
+                    | "uint8"
+                    | "int16"
+                    | "uint16"
+                    | "int32"
+                    | "uint32"
+                    | "int64"
+                    | "uint64"
+                    | "logical"
+            )
+        });
         let layout = match shape.as_slice() {
             [_] => Some(Layout::Vector),
             [_, 1] => Some(Layout::Column),
             [1, _] => Some(Layout::Row),
             [] => Some(Layout::Vector),
+            &[r, c] if numeric && class_ok && r > 0 && c > 0 => {
+                self.matrix(&d, dpath, gpath, rate, r, c, &dtype);
+                return;
+            }
             _ => None,
         };
         let name = self.name(dpath);
@@ -194,6 +249,87 @@ impl Walk<'_> {
     }
 }
 
+impl Walk<'_> {
+    /// A 2-D dataset: one entry per column (and per named column).
+    #[allow(clippy::too_many_arguments)]
+    fn matrix(
+        &mut self,
+        d: &Dataset,
+        dpath: &str,
+        gpath: &str,
+        rate: Option<f64>,
+        r: u64,
+        c: u64,
+        dtype: &Datatype,
+    ) {
+        let attrs = d.attributes();
+        // the longer dimension is the samples
+        let (n, cols, tall) = if r >= c { (r, c, true) } else { (c, r, false) };
+        let tname = match dtype {
+            Datatype::FloatingPoint { size, .. } => format!("f{}", size * 8),
+            Datatype::FixedPoint { size, signed, .. } => {
+                format!("{}{}", if *signed { "i" } else { "u" }, size * 8)
+            }
+            _ => "?".into(),
+        };
+        let names = attr_names(&attrs).filter(|v| v.len() as u64 == cols);
+        let base = self.name(dpath);
+        let group = (!gpath.is_empty()).then(|| self.name(gpath));
+        let unit = attr_text(&attrs, &UNIT);
+        let fs = attr_f64(&attrs, &RATE).or(rate);
+        let dims = format!("{r}×{c}");
+        for k in 0..cols.min(MAX_ENTRIES as u64) {
+            if self.entries.len() >= MAX_ENTRIES {
+                self.truncated = true;
+                return;
+            }
+            let layout = if tall {
+                Layout::ColumnOf(k)
+            } else {
+                Layout::RowOf(k)
+            };
+            let short = if self.mat73 {
+                format!("{}(:,{})", d.name(), k + 1)
+            } else {
+                format!("{}[:,{k}]", d.name())
+            };
+            let full = match &group {
+                Some(g) if self.mat73 => format!("{g}.{short}"),
+                Some(g) => format!("{g}/{short}"),
+                None if self.mat73 => short.clone(),
+                None => format!("/{short}"),
+            };
+            let note = format!(
+                "column {} of the {dims} dataset `{base}`{}",
+                if self.mat73 { k + 1 } else { k },
+                if tall { "" } else { " (stored channel by row)" }
+            );
+            let push = |w: &mut Self, name: String, group: Option<String>, short: String| {
+                let mut e = Entry::numeric(name, group, short, n);
+                e.dtype = tname.clone();
+                e.unit = unit.clone();
+                e.sample_rate_hz = fs;
+                e.note = Some(note.clone());
+                w.entries.push(e);
+                w.datasets.push(Some((d.clone(), layout)));
+            };
+            push(self, full, group.clone(), short);
+            if let Some(names) = &names {
+                let cname = names[k as usize].clone();
+                if !cname.is_empty() {
+                    let sep = if self.mat73 { "." } else { "/" };
+                    push(
+                        self,
+                        format!("{base}{sep}{cname}"),
+                        Some(base.clone()),
+                        cname,
+                    );
+                }
+            }
+        }
+    }
+}
+
 fn read_into(
     d: &Dataset,
     layout: Layout,
@@ -213,6 +349,8 @@ fn read_into(
             (Layout::Vector, _) => vec![range],
             (Layout::Column, _) => vec![range, SliceInfoElem::Index(0)],
             (Layout::Row, _) => vec![SliceInfoElem::Index(0), range],
+            (Layout::ColumnOf(k), _) => vec![range, SliceInfoElem::Index(k)],
+            (Layout::RowOf(k), _) => vec![SliceInfoElem::Index(k), range],
         },
     };
     macro_rules! rd {

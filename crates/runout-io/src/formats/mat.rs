@@ -4,8 +4,10 @@
 //! Read: numeric arrays of every class (double, single, int8 … uint64; the stored element type may
 //! be narrower than the class, as MATLAB writes it), row or column vectors, 2-D matrices (each
 //! column `M(:,j)` of a tall matrix becomes a channel), structs (fields `rec.Fx`, nested
-//! `rec.a.b`), logical arrays. Char, cell, sparse, complex and object arrays are listed with a note
-//! and are not channels. Both byte orders (`IM` / `MI`).
+//! `rec.a.b`), struct arrays (element k's fields as `s(k).Fx`, 1-based), cell arrays (cell k as
+//! `c{k}`; cells holding numeric vectors are channels), logical arrays. Char, sparse, complex and
+//! object arrays (also as cells or fields) are listed with a note and are not channels: naming
+//! one is an error that says what it is. Both byte orders (`IM` / `MI`).
 //!
 //! Memory: the whole file is read and every numeric array decoded into f64 (a compressed variable
 //! must be inflated whole). The decoded size is bounded by
@@ -39,8 +41,11 @@ const MX_SPARSE: u32 = 5;
 
 /// Largest decoded size of the numeric data of one file (bytes of f64).
 const MAX_DECODED: u64 = runout_core::limits::MAX_RESULT_BYTES as u64;
-/// Deepest struct nesting followed.
+/// Deepest struct / cell nesting followed.
 const MAX_DEPTH: usize = 16;
+/// Most elements of a struct or cell array that are read (each has at least an 8-byte tag in
+/// the file, so the file size bounds it anyway; this keeps listings readable).
+const MAX_ELEMENTS: u64 = 10_000;
 
 /// Open a MAT v5 file (read whole, see the module documentation).
 pub fn open_path(path: &Path, file: &str) -> Result<Opened> {
@@ -295,7 +300,7 @@ impl Parser<'_> {
             .trim_end_matches('\0')
             .to_string();
         let (group, name) = match field {
-            Some((g, n)) => (Some(g.to_string()), n.to_string()),
+            Some((g, n)) => (Some(g.to_string()).filter(|g| !g.is_empty()), n.to_string()),
             None => (None, own),
         };
         let full = match &group {
@@ -331,33 +336,70 @@ impl Parser<'_> {
                         String::from_utf8_lossy(&b[..end]).into_owned()
                     })
                     .collect();
-                if count != Some(1) || depth >= MAX_DEPTH {
+                let count = count.unwrap_or(0);
+                if count > MAX_ELEMENTS || depth >= MAX_DEPTH {
                     self.push_note(
                         &gname,
                         &full,
-                        count.unwrap_or(0),
+                        count,
                         "struct",
-                        &format!("{dims_text} struct array (only 1×1 structs are read)"),
+                        &format!("{dims_text} struct array: more than {MAX_ELEMENTS} elements or nested deeper than {MAX_DEPTH}, not read"),
                     );
                     return Ok(());
                 }
-                for fname in &fields {
+                // a struct array: element k (1-based, column-major) as `s(k)`, its fields `s(k).Fx`
+                for k in 0..count {
+                    let owner = if count == 1 {
+                        full.clone()
+                    } else {
+                        format!("{full}({})", k + 1)
+                    };
+                    for fname in &fields {
+                        let at = c.pos;
+                        let (ty, fd) = self.element(&mut c)?;
+                        if ty != MI_MATRIX {
+                            return Err(self.at(
+                                &c,
+                                format!("struct `{owner}` field `{fname}` at {at}: expected a matrix (type 14), found type {ty}"),
+                            ));
+                        }
+                        let fb = if inflated { base } else { base + at as u64 + 8 };
+                        self.matrix(fd, fb, inflated, Some((&owner, fname)), depth + 1)?;
+                    }
+                }
+                Ok(())
+            }
+            MX_CELL => {
+                let count = count.unwrap_or(0);
+                if count > MAX_ELEMENTS || depth >= MAX_DEPTH {
+                    self.push_note(
+                        &gname,
+                        &full,
+                        count,
+                        "cell array",
+                        &format!("{dims_text} cell array: more than {MAX_ELEMENTS} cells or nested deeper than {MAX_DEPTH}, not read"),
+                    );
+                    return Ok(());
+                }
+                // cell k (1-based, column-major) as `c{k}`: numeric vectors are channels, other
+                // element types are listed with a note (and refused by name)
+                for k in 0..count {
                     let at = c.pos;
                     let (ty, fd) = self.element(&mut c)?;
                     if ty != MI_MATRIX {
                         return Err(self.at(
                             &c,
-                            format!("struct `{full}` field `{fname}` at {at}: expected a matrix (type 14), found type {ty}"),
+                            format!("cell array `{full}` cell {} at {at}: expected a matrix (type 14), found type {ty}", k + 1),
                         ));
                     }
                     let fb = if inflated { base } else { base + at as u64 + 8 };
-                    self.matrix(fd, fb, inflated, Some((&full, fname)), depth + 1)?;
+                    let cname = format!("{name}{{{}}}", k + 1);
+                    self.matrix(fd, fb, inflated, Some((&gname, &cname)), depth + 1)?;
                 }
                 Ok(())
             }
-            MX_CELL | MX_OBJECT | MX_CHAR | MX_SPARSE => {
+            MX_OBJECT | MX_CHAR | MX_SPARSE => {
                 let what = match class {
-                    MX_CELL => "cell array",
                     MX_OBJECT => "object",
                     MX_CHAR => "char array",
                     _ => "sparse matrix",

@@ -204,6 +204,35 @@ pub fn recording_from_bytes<'a>(
     ))
 }
 
+/// Like [`recording_from_bytes`], as a reader of one type for text and binary content alike,
+/// not borrowing `bytes` (a binary file is decoded or indexed at open; text is copied once into
+/// the reader). For sources held in memory by a front end (`runout::Source::bytes`).
+pub fn recording_from_shared(
+    name: &str,
+    bytes: std::sync::Arc<[u8]>,
+    selector: Option<&str>,
+    options: &ReadOptions,
+) -> Result<RecordingReader<Box<dyn std::io::BufRead + Send>>> {
+    let n = bytes.len() as u64;
+    let kind = detect(&bytes);
+    if kind == Kind::Text {
+        if let Some(sel) = selector {
+            return Err(RecordingError::Format {
+                file: name.into(),
+                message: format!(
+                    "a selector (`:{sel}`) applies to .mat, TDMS, HDF5 and Parquet files, not to text recordings"
+                ),
+            });
+        }
+        let src: Box<dyn std::io::BufRead + Send> = Box::new(std::io::Cursor::new(bytes));
+        return Ok(RecordingReader::from_reader(src, name, options)?.with_file_bytes(Some(n)));
+    }
+    let opened = open_bytes(kind, &bytes, name)?;
+    let rec = BinaryRecording::new(opened, name, selector, options, Some(n))?;
+    let empty: Box<dyn std::io::BufRead + Send> = Box::new(std::io::Cursor::new(Vec::new()));
+    Ok(RecordingReader::from_binary(empty, rec))
+}
+
 fn unsupported(kind: Kind, file: &str) -> RecordingError {
     RecordingError::Format {
         file: file.into(),
@@ -290,6 +319,84 @@ struct Candidate {
     alias: String,
 }
 
+/// The arrays a selection sees and the names they are delivered under: every array under its
+/// short name, or with a selector `SEL` the arrays of struct / group `SEL` and those named
+/// `NAME_SEL` (as `NAME`), plus file-level time and sample-rate variables.
+fn candidates(catalog: &Catalog, file: &str, selector: Option<&str>) -> Result<Vec<Candidate>> {
+    let listing = || catalog.listing();
+    Ok(match selector {
+        None => catalog
+            .entries
+            .iter()
+            .enumerate()
+            .map(|(i, e)| Candidate {
+                entry: i,
+                alias: e.short.clone(),
+            })
+            .collect(),
+        Some(sel) => {
+            let nsel = norm(sel);
+            let mut v: Vec<Candidate> = catalog
+                .entries
+                .iter()
+                .enumerate()
+                .filter(|(_, e)| e.group.as_deref().map(norm).as_deref() == Some(&nsel))
+                .map(|(i, e)| Candidate {
+                    entry: i,
+                    alias: e.short.clone(),
+                })
+                .collect();
+            let suffix = format!("_{sel}");
+            for (i, e) in catalog.entries.iter().enumerate() {
+                if let Some(base) = e.short.strip_suffix(&suffix) {
+                    if !base.is_empty() && !v.iter().any(|c| c.alias == base) {
+                        v.push(Candidate {
+                            entry: i,
+                            alias: base.to_string(),
+                        });
+                    }
+                }
+            }
+            // file-level scalars and time vectors stay visible (a shared `fs` or `t`)
+            for (i, e) in catalog.entries.iter().enumerate() {
+                let low = e.short.to_ascii_lowercase();
+                if e.group.is_none()
+                    && (TIME_NAMES.contains(&low.as_str()) || RATE_NAMES.contains(&low.as_str()))
+                    && !v.iter().any(|c| c.alias.eq_ignore_ascii_case(&e.short))
+                {
+                    v.push(Candidate {
+                        entry: i,
+                        alias: e.short.clone(),
+                    });
+                }
+            }
+            if v.iter().all(|c| catalog.entries[c.entry].len <= 1) {
+                return Err(RecordingError::Format {
+                    file: file.into(),
+                    message: format!(
+                        "selector `{sel}`: no struct/group `{sel}` and no variables named `NAME_{sel}`; the file holds: {}",
+                        listing()
+                    ),
+                });
+            }
+            v
+        }
+    })
+}
+
+/// The channel names a selection offers (`alias`, index into [`Catalog::entries`]), in file
+/// order: what [`BinaryRecording::new`] accepts in [`ReadOptions::channels`].
+pub fn selectable(
+    catalog: &Catalog,
+    file: &str,
+    selector: Option<&str>,
+) -> Result<Vec<(String, usize)>> {
+    Ok(candidates(catalog, file, selector)?
+        .into_iter()
+        .map(|c| (c.alias, c.entry))
+        .collect())
+}
+
 /// A binary recording: channels and time base chosen, read chunk by chunk.
 pub struct BinaryRecording {
     info: RecordingInfo,
@@ -301,6 +408,20 @@ pub struct BinaryRecording {
     warnings: Vec<String>,
     finished: bool,
     bytes: u64,
+}
+
+/// The other spelling of a 2-D array's column: `D[:,k]` (0-based) ↔ `D(:,k+1)` (1-based).
+pub fn column_spelling(name: &str) -> Option<String> {
+    let n = name.trim();
+    if let Some(base) = n.strip_suffix(']') {
+        let (base, k) = base.rsplit_once("[:,")?;
+        let k: u64 = k.trim().parse().ok()?;
+        return Some(format!("{base}(:,{})", k + 1));
+    }
+    let base = n.strip_suffix(')')?;
+    let (base, j) = base.rsplit_once("(:,")?;
+    let j: u64 = j.trim().parse().ok()?;
+    (j >= 1).then(|| format!("{base}[:,{}]", j - 1))
 }
 
 fn norm(name: &str) -> String {
@@ -323,72 +444,27 @@ impl BinaryRecording {
     ) -> Result<Self> {
         let Opened { catalog, source } = opened;
         let listing = || catalog.listing();
-        let cands: Vec<Candidate> = match selector {
-            None => catalog
-                .entries
-                .iter()
-                .enumerate()
-                .map(|(i, e)| Candidate {
-                    entry: i,
-                    alias: e.short.clone(),
-                })
-                .collect(),
-            Some(sel) => {
-                let nsel = norm(sel);
-                let mut v: Vec<Candidate> = catalog
-                    .entries
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, e)| e.group.as_deref().map(norm).as_deref() == Some(&nsel))
-                    .map(|(i, e)| Candidate {
-                        entry: i,
-                        alias: e.short.clone(),
-                    })
-                    .collect();
-                let suffix = format!("_{sel}");
-                for (i, e) in catalog.entries.iter().enumerate() {
-                    if let Some(base) = e.short.strip_suffix(&suffix) {
-                        if !base.is_empty() && !v.iter().any(|c| c.alias == base) {
-                            v.push(Candidate {
-                                entry: i,
-                                alias: base.to_string(),
-                            });
-                        }
-                    }
-                }
-                // file-level scalars and time vectors stay visible (a shared `fs` or `t`)
-                for (i, e) in catalog.entries.iter().enumerate() {
-                    let low = e.short.to_ascii_lowercase();
-                    if e.group.is_none()
-                        && (TIME_NAMES.contains(&low.as_str())
-                            || RATE_NAMES.contains(&low.as_str()))
-                        && !v.iter().any(|c| c.alias.eq_ignore_ascii_case(&e.short))
-                    {
-                        v.push(Candidate {
-                            entry: i,
-                            alias: e.short.clone(),
-                        });
-                    }
-                }
-                if v.iter().all(|c| catalog.entries[c.entry].len <= 1) {
-                    return Err(RecordingError::Format {
-                        file: file.into(),
-                        message: format!(
-                            "selector `{sel}`: no struct/group `{sel}` and no variables named `NAME_{sel}`; the file holds: {}",
-                            listing()
-                        ),
-                    });
-                }
-                v
-            }
-        };
-        let find = |name: &str| -> Option<usize> {
+        let cands = candidates(&catalog, file, selector)?;
+        let find_exact = |name: &str| -> Option<usize> {
             let n = norm(name);
             let by = |f: &dyn Fn(&Candidate) -> bool| cands.iter().find(|c| f(c)).map(|c| c.entry);
             by(&|c| c.alias == n)
                 .or_else(|| by(&|c| norm(&catalog.entries[c.entry].name) == n))
                 .or_else(|| by(&|c| c.alias.eq_ignore_ascii_case(&n)))
                 .or_else(|| by(&|c| norm(&catalog.entries[c.entry].name).eq_ignore_ascii_case(&n)))
+                // a name without the unit suffix of the array's name (`xI` for `xI_um`), as
+                // in a text header
+                .or_else(|| {
+                    by(&|c| {
+                        crate::recording::header::split_unit(&c.alias)
+                            .0
+                            .eq_ignore_ascii_case(&n)
+                    })
+                })
+        };
+        // a column of a 2-D array in either spelling: `D[:,k]` (0-based) or `D(:,k+1)` (MATLAB)
+        let find = |name: &str| -> Option<usize> {
+            find_exact(name).or_else(|| column_spelling(name).and_then(|a| find_exact(&a)))
         };
         let missing = |what: &str, name: &str| RecordingError::MissingChannel {
             file: file.into(),
@@ -487,6 +563,24 @@ impl BinaryRecording {
             .then(|| (t_head.len() - 1) as f64 / (t_head[t_head.len() - 1] - t_head[0]))
             .filter(|f| f.is_finite() && *f > 0.0);
         let var_rate = rate_var.and_then(|i| catalog.entries[i].scalar);
+        // a named time base and a given rate must agree (a rate variable to 1e-9 relative; a
+        // time vector sample by sample within ½ sample period, checked as it is read)
+        if let (Some(f), Some(v), Some(i), Some(_)) = (
+            options.sample_rate_hz,
+            var_rate,
+            rate_var,
+            &options.time_column,
+        ) {
+            if ((v - f) / f).abs().is_nan() || ((v - f) / f).abs() > 1e-9 {
+                return Err(RecordingError::Format {
+                    file: file.into(),
+                    message: format!(
+                        "the time variable `{}` says {v} Hz but --sample-rate-hz is {f} Hz: give one, or make them agree",
+                        catalog.entries[i].name
+                    ),
+                });
+            }
+        }
         let (rate, rate_source) = if let Some(f) = options.sample_rate_hz {
             (f, "given by the caller".to_string())
         } else if let (Some(f), Some(i)) = (var_rate, rate_var) {
@@ -530,7 +624,11 @@ impl BinaryRecording {
             Channel {
                 name: e.short.clone(),
                 header: e.name.clone(),
-                unit: e.unit.clone(),
+                // the file's unit, else the unit suffix of the name (`xI_um`), as in a text header
+                unit: e
+                    .unit
+                    .clone()
+                    .or_else(|| crate::recording::header::split_unit(&e.short).1),
                 column: k + 1,
             }
         };
@@ -658,6 +756,7 @@ impl BinaryRecording {
                         ),
                     });
                 }
+                self.check_times(&chunk.time_s)?;
             }
             None => {
                 let fs = self.info.sample_rate_hz;
@@ -665,6 +764,39 @@ impl BinaryRecording {
                 chunk
                     .time_s
                     .extend((0..n as u64).map(|k| t0 + (self.sample + k) as f64 / fs));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl BinaryRecording {
+    /// A time vector must increase and stay on the sample-rate grid: every sample within ½ sample
+    /// period of t₀ + k/f_s (the tolerance of the text reader's time column).
+    fn check_times(&mut self, times: &[f64]) -> Result<()> {
+        let fs = self.info.sample_rate_hz;
+        let t0 = self.info.start_time_s;
+        let name = self
+            .info
+            .time_column
+            .as_ref()
+            .map_or("time", |c| c.header.as_str());
+        for (k, &t) in times.iter().enumerate() {
+            let sample = self.sample + k as u64;
+            let expected = t0 + sample as f64 / fs;
+            if t.is_nan() || (t - expected).abs() > 0.5 / fs {
+                return Err(RecordingError::Format {
+                    file: self.info.file.clone(),
+                    message: format!(
+                        "time variable `{name}`, sample {sample}: {t} s, but sample {sample} at {fs} Hz (the sample rate {}) from t0 = {t0} s is at {expected} s: the times are not evenly spaced within ½ sample period{}",
+                        self.info.sample_rate_source,
+                        if self.info.sample_rate_source.contains("caller") {
+                            " (the time variable disagrees with --sample-rate-hz)"
+                        } else {
+                            ""
+                        }
+                    ),
+                });
             }
         }
         Ok(())

@@ -33,15 +33,16 @@ pub struct AxisMappingError {
 
 impl AxisMapping {
     /// Parse `x = -Fy, y = -Fx, z = -Fz` (entries separated by `,` or `;`, any order, `+`
-    /// optional, at least x or y, each axis and each channel at most once).
+    /// optional, at least x or y, each axis and each channel at most once). A channel may be a
+    /// column of a 2-D array, `M(:,2)` or `D[:,1]` (the comma inside brackets does not separate).
     pub fn parse(text: &str) -> Result<Self, AxisMappingError> {
         let err = |message: String| AxisMappingError {
             text: text.to_string(),
             message,
         };
         let mut axes: [Option<AxisSource>; 3] = [None, None, None];
-        for entry in text
-            .split([',', ';'])
+        for entry in split_entries(text)
+            .into_iter()
             .map(str::trim)
             .filter(|e| !e.is_empty())
         {
@@ -212,6 +213,26 @@ impl ResolvedAxes {
     pub fn value(&self, axis: FrameAxis, row: &[f64]) -> Option<f64> {
         self.sources[axis.index()].map(|(i, s)| s * row[i])
     }
+}
+
+/// Split a mapping into entries at `,` or `;` outside brackets (`D[:,1]`, `M(:,2)`, `c{1}` stay
+/// whole).
+pub(crate) fn split_entries(text: &str) -> Vec<&str> {
+    let mut out = Vec::new();
+    let (mut depth, mut start) = (0i32, 0);
+    for (i, ch) in text.char_indices() {
+        match ch {
+            '[' | '(' | '{' => depth += 1,
+            ']' | ')' | '}' => depth = (depth - 1).max(0),
+            ',' | ';' if depth == 0 => {
+                out.push(&text[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    out.push(&text[start..]);
+    out
 }
 
 #[cfg(test)]

@@ -33,6 +33,7 @@ mod text;
 mod writer;
 
 pub use crate::formats::{open_recording, recording_from_bytes};
+pub(crate) use axis::split_entries;
 pub use axis::AxisMappingError;
 pub use axis::{AxisMapping, AxisSource, FrameAxis, ResolvedAxes};
 pub use error::RecordingError;

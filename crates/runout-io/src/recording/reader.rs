@@ -27,9 +27,17 @@ struct LineSource<R> {
     line_no: u64,
     bytes: u64,
     file: String,
+    /// Table mode: lines starting with `#` are comments (skipped like blank lines).
+    comments: bool,
 }
 
 impl<R: BufRead> LineSource<R> {
+    /// Whether a line carries no data (blank, or a `#` comment in table mode).
+    fn is_blank(&self, line: &[u8]) -> bool {
+        let t = trim_field(line);
+        t.is_empty() || (self.comments && t.first() == Some(&b'#'))
+    }
+
     /// Next line from the underlying reader (not from `pending`), without its line ending.
     fn read_src(&mut self, buf: &mut Vec<u8>) -> Result<Option<u64>> {
         buf.clear();
@@ -83,6 +91,9 @@ impl<R: BufRead> LineSource<R> {
     /// Next non-blank line, checked to be text.
     fn next_nonblank(&mut self, buf: &mut Vec<u8>) -> Result<Option<u64>> {
         while let Some(n) = self.next(buf)? {
+            if self.comments && trim_field(buf).first() == Some(&b'#') {
+                continue;
+            }
             self.check_text(n, buf)?;
             if !trim_field(buf).is_empty() {
                 return Ok(Some(n));
@@ -130,6 +141,9 @@ pub struct RecordingReader<R> {
     finished: bool,
     /// A binary format (.mat, TDMS, HDF5, Parquet) delivering the chunks instead of the lines.
     binary: Option<Box<crate::formats::BinaryRecording>>,
+    /// Table mode ([`RecordingReader::table_from_reader`]): the line number of each row of the
+    /// last chunk.
+    row_lines: Option<Vec<u64>>,
 }
 
 impl<R: BufRead + Send + 'static> RecordingReader<R> {
@@ -142,6 +156,7 @@ impl<R: BufRead + Send + 'static> RecordingReader<R> {
             line_no,
             bytes,
             file,
+            comments,
         } = self.lines;
         RecordingReader {
             lines: LineSource {
@@ -150,6 +165,7 @@ impl<R: BufRead + Send + 'static> RecordingReader<R> {
                 line_no,
                 bytes,
                 file,
+                comments,
             },
             info: self.info,
             slots: self.slots,
@@ -162,6 +178,7 @@ impl<R: BufRead + Send + 'static> RecordingReader<R> {
             chunk_rows: self.chunk_rows,
             finished: self.finished,
             binary: self.binary,
+            row_lines: self.row_lines,
         }
     }
 }
@@ -205,6 +222,18 @@ impl<R: BufRead> RecordingReader<R> {
     /// the DynoWare `Sampling rate [Hz]` line, the time column's step; a time column is then
     /// checked row by row against it (strictly increasing, within half a sample period).
     pub fn from_reader(src: R, file: &str, options: &ReadOptions) -> Result<Self> {
+        Self::from_reader_mode(src, file, options, false)
+    }
+
+    /// Table mode, for tables whose columns are interpreted by the caller (the displacement
+    /// signal, `crate::displacement`): every column is a channel (no time column is detected or
+    /// checked; the sample rate is not used and reported as 1 Hz), lines starting with `#` are
+    /// comments, and [`RecordingReader::chunk_lines`] gives the line of each row.
+    pub(crate) fn table_from_reader(src: R, file: &str) -> Result<Self> {
+        Self::from_reader_mode(src, file, &ReadOptions::new(), true)
+    }
+
+    fn from_reader_mode(src: R, file: &str, options: &ReadOptions, table: bool) -> Result<Self> {
         options.validate(file)?;
         let mut lines = LineSource {
             src,
@@ -212,6 +241,7 @@ impl<R: BufRead> RecordingReader<R> {
             line_no: 0,
             bytes: 0,
             file: file.to_string(),
+            comments: table,
         };
         let mut buf = Vec::new();
         let Some(first_no) = lines.next_nonblank(&mut buf)? else {
@@ -229,7 +259,7 @@ impl<R: BufRead> RecordingReader<R> {
             let mut l = Vec::new();
             match lines.read_src(&mut l)? {
                 Some(n) => {
-                    if !trim_field(&l).is_empty() {
+                    if !lines.is_blank(&l) {
                         peeked += 1;
                     }
                     lines.pending.push_back((n, l));
@@ -240,7 +270,7 @@ impl<R: BufRead> RecordingReader<R> {
         let first_data = lines
             .pending
             .iter()
-            .find(|(_, l)| !trim_field(l).is_empty())
+            .find(|(_, l)| !lines.is_blank(l))
             .map(|(n, l)| (*n, l.clone()));
         let Some((_, first_data)) = first_data else {
             return Err(RecordingError::NoData {
@@ -250,7 +280,7 @@ impl<R: BufRead> RecordingReader<R> {
         };
         let delim = header.delimiter;
         let decimal_comma = detect_decimal_comma(&first_data, delim);
-        Self::assemble(lines, header, decimal_comma, options, warnings)
+        Self::assemble(lines, header, decimal_comma, options, warnings, table)
     }
 
     /// Resolve columns, sample rate and time checks from the parsed header.
@@ -260,6 +290,7 @@ impl<R: BufRead> RecordingReader<R> {
         decimal_comma: bool,
         options: &ReadOptions,
         mut warnings: Vec<String>,
+        table: bool,
     ) -> Result<Self> {
         let file = lines.file.clone();
         let columns = header.columns(&mut warnings);
@@ -276,6 +307,7 @@ impl<R: BufRead> RecordingReader<R> {
         };
         let time = match &options.time_column {
             Some(name) => Some(find_column(&columns, name).ok_or_else(|| missing(name))?),
+            None if table => None,
             None => columns.iter().position(|c| {
                 matches!(
                     c.name.to_ascii_lowercase().as_str(),
@@ -331,7 +363,9 @@ impl<R: BufRead> RecordingReader<R> {
         let time_rate = (times.len() >= 2)
             .then(|| (times.len() - 1) as f64 / (times[times.len() - 1] - times[0]))
             .filter(|f| f.is_finite() && *f > 0.0);
-        let (rate, source) = if let Some(f) = options.sample_rate_hz {
+        let (rate, source) = if table {
+            (1.0, "not used (a table read by its caller)".to_string())
+        } else if let Some(f) = options.sample_rate_hz {
             if let Some(m) = meta_rate {
                 if ((m - f) / f).abs() > 1e-9 {
                     warnings.push(format!(
@@ -386,6 +420,7 @@ impl<R: BufRead> RecordingReader<R> {
             },
             finished: false,
             binary: None,
+            row_lines: table.then(Vec::new),
         })
     }
 
@@ -400,6 +435,7 @@ impl<R: BufRead> RecordingReader<R> {
                 line_no: 0,
                 bytes: 0,
                 file: info.file.clone(),
+                comments: false,
             },
             info,
             slots: Vec::new(),
@@ -412,6 +448,7 @@ impl<R: BufRead> RecordingReader<R> {
             chunk_rows: DEFAULT_CHUNK_ROWS,
             finished: false,
             binary: Some(Box::new(rec)),
+            row_lines: None,
         }
     }
 
@@ -456,6 +493,9 @@ impl<R: BufRead> RecordingReader<R> {
         for v in &mut chunk.values {
             v.clear();
         }
+        if let Some(l) = &mut self.row_lines {
+            l.clear();
+        }
         if self.finished {
             return Ok(0);
         }
@@ -473,11 +513,14 @@ impl<R: BufRead> RecordingReader<R> {
                 }
                 Err(e) => break Err(e),
             };
-            if trim_field(&buf).is_empty() {
+            if self.lines.is_blank(&buf) {
                 continue;
             }
             if let Err(e) = self.parse_row(line, &buf, chunk) {
                 break Err(e);
+            }
+            if let Some(l) = &mut self.row_lines {
+                l.push(line);
             }
             rows += 1;
         };
@@ -486,6 +529,11 @@ impl<R: BufRead> RecordingReader<R> {
             self.finished = true;
         }
         result.map(|()| rows)
+    }
+
+    /// Table mode: the line number of each row of the last chunk (empty otherwise).
+    pub(crate) fn chunk_lines(&self) -> &[u64] {
+        self.row_lines.as_deref().unwrap_or(&[])
     }
 
     /// Next chunk of the configured size (`ReadOptions::chunk_rows`), `None` at the end.

@@ -5,8 +5,11 @@ use proptest::prelude::*;
 use runout_io::recording::{recording_from_bytes, ReadOptions, RecordingChunk};
 use std::path::Path;
 
-const FIXTURES: [&str; 11] = [
+const FIXTURES: [&str; 14] = [
     "mat5_plain.mat",
+    "mat5_cells.mat",
+    "matrix.h5",
+    "mat73_matrix.mat",
     "mat5_compressed.mat",
     "mat5_struct.mat",
     "mat73.mat",

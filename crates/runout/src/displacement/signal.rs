@@ -11,7 +11,7 @@ use runout_core::displacement::{
     ToothFit, ToothFitOptions,
 };
 use runout_core::Cutter;
-use runout_io::displacement::{read_signal, SignalSection};
+use runout_io::displacement::{read_signal_with, SignalOptions, SignalSection};
 use runout_io::displacement_plot::TeethPlot;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -31,9 +31,12 @@ pub enum ReferenceChoice {
 /// `runout displacement signal`.
 #[derive(Debug, Clone)]
 pub struct SignalRequest {
-    /// CSV with `time_<s|ms>`, `disp_<name>_<um|mm>`, optional `pulse` or `encoder_<deg|rad>`.
+    /// A recording of any format (CSV, .mat, TDMS, HDF5, Parquet) with `time_<s|ms>`,
+    /// `disp_<name>_<um|mm>`, optional `pulse` or `encoder_<deg|rad>` (or named in `read`).
     pub recording: Source,
     pub section: SignalSection,
+    /// Channel mapping, time variable, sample rate (Hz); defaults follow the naming convention.
+    pub read: SignalOptions,
     /// Angle of each sensor (rad, file order); `None`: 0 for a single channel.
     pub sensor_angles_rad: Option<Vec<f64>>,
     pub sensor: Sensor,
@@ -164,7 +167,7 @@ fn sensor_angles(given: &Option<Vec<f64>>, n: usize) -> Result<Vec<f64>> {
 /// Fit the runout vector to a raw displacement signal.
 pub fn signal(req: &SignalRequest) -> Result<SignalReport> {
     let file = req.recording.name().to_string();
-    let table = read_signal(req.recording.table_input(), &req.section)?;
+    let table = read_signal_with(req.recording.table_input(), &req.section, &req.read)?;
     let sign = req.sensor.sign;
     let angles = sensor_angles(&req.sensor_angles_rad, table.channels.len())?;
     let beam = req.sensor.beam;

@@ -23,6 +23,8 @@ pub(crate) struct Resolved {
     pub(crate) sensor_unit: Option<String>,
     pub(crate) sensitivity_um_per_v: Option<f64>,
     pub(crate) sample_rate_hz: Option<f64>,
+    /// `--time-var`: the time base from a named channel / variable.
+    pub(crate) time_var: Option<String>,
 }
 
 pub(crate) fn load_config(config: &Source, rate: Option<f64>) -> Result<Resolved> {
@@ -169,6 +171,7 @@ pub(crate) fn load_config(config: &Source, rate: Option<f64>) -> Result<Resolved
         sensor_unit: cfg.recording.sensor_unit.clone(),
         sensitivity_um_per_v: sensitivity,
         sample_rate_hz: rate,
+        time_var: None,
         setup,
         cfg,
         stiffness_source: source,
@@ -325,6 +328,7 @@ pub(crate) struct Plan {
 pub(crate) fn open(source: &Source, r: &Resolved, names: &[String]) -> Result<Reader> {
     let mut o = ReadOptions::new().channels(names).chunk_rows(65_536);
     o.sample_rate_hz = r.sample_rate_hz;
+    o.time_column = r.time_var.clone();
     source.open_recording(&o).map_err(|e| match e {
         RecordingError::NoSampleRate { .. } => {
             anyhow::anyhow!("{e}\n(or set [recording] sample_rate_hz in the config)")

@@ -25,6 +25,9 @@ pub struct ForceRequest {
     pub config: Source,
     /// Sample rate (Hz) when the file has no time column; overrides the config.
     pub sample_rate_hz: Option<f64>,
+    /// Channel / variable holding the sample times (or, in a binary file, a scalar sample rate
+    /// in Hz) used as the time base (`--time-var`); `None`: auto-detected.
+    pub time_var: Option<String>,
     /// Parse the text again in pass 2 instead of keeping a temporary binary copy.
     pub reparse: bool,
     /// The time series output, if any: its name (reported) and format.
@@ -38,6 +41,7 @@ impl ForceRequest {
             recording,
             config,
             sample_rate_hz: None,
+            time_var: None,
             reparse: false,
             series: None,
         }
@@ -367,6 +371,7 @@ pub fn force_to(
     progress: &mut dyn Progress,
 ) -> Result<ForceReport> {
     let mut r = load_config(&req.config, req.sample_rate_hz)?;
+    r.time_var = req.time_var.clone();
     let (plan, info) = plan(&req.recording, &r)?;
     r.setup.sample_rate_hz = info.sample_rate_hz;
     r.setup.start_time_s = info.start_time_s;

@@ -9,9 +9,21 @@ use runout_io::displacement::SignalSection;
 /// Arguments of `runout displacement signal`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// CSV with `time_<s|ms>`, `disp_<name>_<um|mm>` channels, optional `pulse` (once per revolution)
-    /// or `encoder_<deg|rad>`.
+    /// Recording (CSV, .mat, TDMS, HDF5, Parquet; `FILE:SEL` selects one of several) with
+    /// `time_<s|ms>`, `disp_<name>_<um|mm>` channels, optional `pulse` (once per revolution) or
+    /// `encoder_<deg|rad>`; other names through --channels.
     pub recording: PathBuf,
+    /// Channels by name when they do not follow the naming convention, like the identify axis
+    /// mapping: `a = Dx [um], b = Dy [mm], pulse = trig, encoder = angle [deg]` (unit in
+    /// brackets, else the unit the file states).
+    #[arg(long, allow_hyphen_values = true)]
+    pub channels: Option<String>,
+    #[command(flatten)]
+    pub time: crate::flags::TimeFlags,
+    /// Sample rate (Hz): the time base of a file without a time channel; with one, its times
+    /// must lie on this rate's grid (within ¼ sample).
+    #[arg(long, allow_hyphen_values = true)]
+    pub sample_rate_hz: Option<String>,
     /// Angle of each displacement sensor (deg, in the direction of rotation, comma-separated, one per
     /// `disp_*` column in file order). Default 0 for a single channel.
     #[arg(long, allow_hyphen_values = true)]
@@ -92,6 +104,11 @@ pub fn run(a: Args) -> Result<()> {
     let req = SignalRequest {
         recording: Source::path(&a.recording),
         section,
+        read: runout_io::displacement::SignalOptions {
+            channels: a.channels.clone(),
+            time_var: a.time.time_var.clone(),
+            sample_rate_hz: quantity("sample-rate-hz", &a.sample_rate_hz, Quantity::FrequencyHz)?,
+        },
         sensor_angles_rad,
         sensor: a.beam.sensor()?,
         reference,

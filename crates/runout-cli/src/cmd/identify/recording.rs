@@ -45,6 +45,8 @@ pub struct RecordingArgs {
     /// Sample rate (Hz), when the file has neither a time column nor a sampling-rate line.
     #[arg(long)]
     pub sample_rate_hz: Option<String>,
+    #[command(flatten)]
+    pub time: crate::flags::TimeFlags,
     /// Start of the section to analyse (s); default: the steady cut, detected.
     #[arg(long)]
     pub from_s: Option<String>,
@@ -128,7 +130,8 @@ pub fn run(a: RecordingArgs) -> Result<()> {
     }
     let sources = a.recordings.iter().map(Source::path).collect();
     let config = a.config.as_ref().map(Source::path);
-    let req = identify::resolve(config.as_ref(), a.layer(), sources)?;
+    let mut req = identify::resolve(config.as_ref(), a.layer(), sources)?;
+    req.time_var = a.time.time_var.clone();
     let mut inputs: Vec<&Path> = a.recordings.iter().map(|p| p.as_path()).collect();
     if let Some(c) = &a.config {
         inputs.push(c);

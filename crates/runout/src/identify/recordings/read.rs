@@ -126,6 +126,7 @@ pub(super) fn analyse(
     if let Some(fs) = req.sample_rate_hz {
         opts = opts.sample_rate_hz(fs);
     }
+    opts.time_column = req.time_var.clone();
     let mut reader = src.open_recording(&opts)?;
     let info = reader.info().clone();
     let ch = channels(src.name(), &info, req)?;

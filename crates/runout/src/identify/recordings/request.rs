@@ -52,6 +52,9 @@ pub struct RecordingsRequest {
     pub axes: Option<String>,
     /// Sample rate (Hz), when a file has neither a time column nor a rate line.
     pub sample_rate_hz: Option<f64>,
+    /// Channel / variable holding the sample times (or, in a binary file, a scalar sample rate
+    /// in Hz) used as the time base (`--time-var`); `None`: auto-detected.
+    pub time_var: Option<String>,
     /// Section to analyse (s); `None`: the steady cut, detected.
     pub section_s: Option<(f64, f64)>,
     /// Component of the per-tooth peaks (default the resultant |F_xy|).
@@ -83,6 +86,7 @@ impl RecordingsRequest {
             cuts,
             axes: None,
             sample_rate_hz: None,
+            time_var: None,
             section_s: None,
             peak_component: ForceComponent::Fxy,
             pulse_channel: None,
