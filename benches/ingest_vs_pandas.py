@@ -78,18 +78,19 @@ def header_rows(path):
     sys.exit(f"{path}: no `Time,…` column row")
 
 
-def run_timed(cmd):
+def run_timed(cmd, env=None):
     """Wall time, stdout and peak RSS (KiB) of one child process (`os.wait4`'s own rusage)."""
     import tempfile
     with tempfile.TemporaryFile() as out:
         t0 = time.perf_counter()
-        p = subprocess.Popen(cmd, stdout=out, stderr=subprocess.DEVNULL)
+        p = subprocess.Popen(cmd, stdout=out, stderr=subprocess.DEVNULL, env=env)
         _, status, usage = os.wait4(p.pid, 0)
         dt = time.perf_counter() - t0
         p.returncode = os.waitstatus_to_exitcode(status)
         if p.returncode != 0:
             sys.exit(f"{' '.join(cmd)}: exit {p.returncode}")
         out.seek(0)
+        run_timed.cpu = usage.ru_utime + usage.ru_stime
         return dt, out.read().decode(), usage.ru_maxrss
 
 
@@ -127,14 +128,16 @@ def main():
     def time_runout(binary):
         cmd = [binary, "identify", path, "--config", toml, "--json", "-"]
         times, peak, report = [], 0, None
+        cpu = []
         for _ in range(args.repeats):
             dt, out, rss = run_timed(cmd)
+            cpu.append(run_timed.cpu)
             times.append(dt)
             peak = max(peak, rss)
             report = json.loads(out)
-        return times, peak, report
+        return times, peak, report, statistics.median(cpu)
 
-    rust, rust_rss, report = time_runout(args.runout)
+    rust, rust_rss, report, rust_cpu = time_runout(args.runout)
     base = time_runout(args.baseline) if args.baseline else None
     pd_times, pd_rss = [], 0
     for _ in range(args.repeats):
@@ -148,12 +151,18 @@ def main():
     mb = size / 1e6
     print(f"file: {path}, {mb:.1f} MB; load average {open('/proc/loadavg').read().split()[:3]}")
     print(f"runout identify (whole job, whole process, median of {len(rust)}): {tr:.3f} s = "
-          f"{mb / tr:.0f} MB/s, peak RSS {rust_rss / 1024:.1f} MB")
+          f"{mb / tr:.0f} MB/s, CPU {rust_cpu:.3f} s, peak RSS {rust_rss / 1024:.1f} MB")
+    same = None
     if base is not None:
+        # the full-signal fit sums over disks in rayon's run-dependent grouping: compare the
+        # reports of one-thread runs (fixed order), provenance aside
+        one = dict(os.environ, RAYON_NUM_THREADS="1")
+        rep = [json.loads(run_timed([b, "identify", path, "--config", toml, "--json", "-"], one)[1])
+               for b in (args.runout, args.baseline)]
+        same = strip(rep[0]) == strip(rep[1])
         tb = statistics.median(base[0])
-        print(f"baseline {args.baseline} (same run): {tb:.3f} s = {mb / tb:.0f} MB/s, "
-              f"peak RSS {base[1] / 1024:.1f} MB; same report (provenance aside, thread order may move "
-              f"last digits): {strip(base[2]) == strip(report)}")
+        print(f"baseline {args.baseline} (same run): {tb:.3f} s = {mb / tb:.0f} MB/s, CPU {base[3]:.3f} s, "
+              f"peak RSS {base[1] / 1024:.1f} MB; identical reports on one thread (provenance aside): {same}")
     print(f"pandas {pd.__version__} read_csv + mean (median of {len(pd_times)}): {tp:.3f} s = "
           f"{mb / tp:.0f} MB/s, peak RSS {pd_rss / 1024:.1f} MB (whole interpreter)")
     print(f"ratio (wall): runout identify takes {tr / tp:.2f}× the pandas read "
