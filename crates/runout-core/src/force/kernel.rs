@@ -197,12 +197,6 @@ pub(crate) struct SimConsts {
     pub kc: CuttingCoefficients,
 }
 
-/// Basis rows of the edge forces (they follow the edge mask, the others h > 0).
-const EDGE_ROW: [bool; 16] = [
-    false, false, true, true, false, true, false, false, true, true, false, false, true, true,
-    false, true,
-];
-
 /// Accumulators of one block (each row `stride` samples long).
 pub(crate) struct Acc {
     pub stride: usize,
@@ -259,6 +253,14 @@ fn row(acc: &mut [f64], r: usize, stride: usize, t: usize) -> &mut V {
     (&mut acc[r * stride + t..r * stride + t + L])
         .try_into()
         .expect("lane vector")
+}
+
+/// `a += x(l)` on the lanes where `on`, `+ 0.0` elsewhere (one straight lane loop).
+#[inline(always)]
+fn masked_add(a: &mut V, on: &[bool; L], x: impl Fn(usize) -> f64) {
+    for l in 0..L {
+        a[l] += if on[l] { x(l) } else { 0.0 };
+    }
 }
 
 #[inline(always)]
@@ -384,6 +386,11 @@ pub(crate) fn accumulate<C: LaneChip, const GENERAL: bool, const SIM: bool>(
                         s[l] = sth[l] * cpsi + cth[l] * spsi;
                         co[l] = cth[l] * cpsi - sth[l] * spsi;
                     }
+                    if !win.iter().any(|&w| w) {
+                        // no lane inside the window (a guard vector): nothing to add
+                        t += L;
+                        continue;
+                    }
                     let mut h = [0.0; L];
                     let mut gx = [0.0; L];
                     let mut gy = [0.0; L];
@@ -433,49 +440,37 @@ pub(crate) fn accumulate<C: LaneChip, const GENERAL: bool, const SIM: bool>(
                         add_to(row(&mut acc.own, 2 * i, stride, t), &dxy[0]);
                         add_to(row(&mut acc.own, 2 * i + 1, stride, t), &dxy[1]);
                     } else {
+                        // Row by row, each a straight lane loop (vectorised): the old loops'
+                        // expression per row with the same association, masked by a select.
                         let base = &mut acc.base;
-                        let mut v = [[0.0; L]; 16];
-                        let rows = if GENERAL { 16 } else { 6 };
+                        let mut hz = [0.0; L];
                         for l in 0..L {
-                            let (hc, ec) = (cut[l], edge[l]);
-                            let x = if GENERAL {
-                                let hz = h[l] * dz;
-                                [
-                                    hz * co[l],
-                                    hz * s[l],
-                                    co[l] * db,
-                                    s[l] * db,
-                                    sk * hz,
-                                    sk * db,
-                                    sk * hz * co[l],
-                                    sk * hz * s[l],
-                                    sk * co[l] * db,
-                                    sk * s[l] * db,
-                                    ck * hz * co[l],
-                                    ck * hz * s[l],
-                                    ck * co[l] * db,
-                                    ck * s[l] * db,
-                                    ck * hz,
-                                    ck * db,
-                                ]
-                            } else {
-                                let mut x = [0.0; 16];
-                                x[0] = h[l] * co[l] * dz;
-                                x[1] = h[l] * s[l] * dz;
-                                x[2] = co[l] * dz;
-                                x[3] = s[l] * dz;
-                                x[4] = h[l] * dz;
-                                x[5] = dz;
-                                x
-                            };
-                            for r in 0..rows {
-                                // edge rows 2, 3, 5, 8, 9, 12, 13, 15 follow the edge mask
-                                let on = if EDGE_ROW[r] { ec } else { hc };
-                                v[r][l] = if on { x[r] } else { 0.0 };
-                            }
+                            hz[l] = h[l] * dz;
                         }
-                        for (r, vr) in v.iter().enumerate().take(rows) {
-                            add_to(row(base, r, stride, t), vr);
+                        if GENERAL {
+                            masked_add(row(base, 0, stride, t), &cut, |l| hz[l] * co[l]);
+                            masked_add(row(base, 1, stride, t), &cut, |l| hz[l] * s[l]);
+                            masked_add(row(base, 2, stride, t), &edge, |l| co[l] * db);
+                            masked_add(row(base, 3, stride, t), &edge, |l| s[l] * db);
+                            masked_add(row(base, 4, stride, t), &cut, |l| sk * hz[l]);
+                            masked_add(row(base, 5, stride, t), &edge, |_| sk * db);
+                            masked_add(row(base, 6, stride, t), &cut, |l| sk * hz[l] * co[l]);
+                            masked_add(row(base, 7, stride, t), &cut, |l| sk * hz[l] * s[l]);
+                            masked_add(row(base, 8, stride, t), &edge, |l| sk * co[l] * db);
+                            masked_add(row(base, 9, stride, t), &edge, |l| sk * s[l] * db);
+                            masked_add(row(base, 10, stride, t), &cut, |l| ck * hz[l] * co[l]);
+                            masked_add(row(base, 11, stride, t), &cut, |l| ck * hz[l] * s[l]);
+                            masked_add(row(base, 12, stride, t), &edge, |l| ck * co[l] * db);
+                            masked_add(row(base, 13, stride, t), &edge, |l| ck * s[l] * db);
+                            masked_add(row(base, 14, stride, t), &cut, |l| ck * hz[l]);
+                            masked_add(row(base, 15, stride, t), &edge, |_| ck * db);
+                        } else {
+                            masked_add(row(base, 0, stride, t), &cut, |l| h[l] * co[l] * dz);
+                            masked_add(row(base, 1, stride, t), &cut, |l| h[l] * s[l] * dz);
+                            masked_add(row(base, 2, stride, t), &edge, |l| co[l] * dz);
+                            masked_add(row(base, 3, stride, t), &edge, |l| s[l] * dz);
+                            masked_add(row(base, 4, stride, t), &cut, |l| hz[l]);
+                            masked_add(row(base, 5, stride, t), &edge, |_| dz);
                         }
                         for p in 0..np {
                             let (g, f) = match p {
@@ -486,25 +481,21 @@ pub(crate) fn accumulate<C: LaneChip, const GENERAL: bool, const SIM: bool>(
                             };
                             let d = &mut acc.deriv;
                             let r0 = p * drows;
-                            let mut w = [[0.0; L]; 8];
+                            let mut gh = [0.0; L];
                             for l in 0..L {
-                                let gh = if p < 2 { g[l] * dz } else { f * g[l] * dz };
-                                let x = [
-                                    gh * co[l],
-                                    gh * s[l],
-                                    if GENERAL { sk * gh } else { gh },
-                                    sk * gh * co[l],
-                                    sk * gh * s[l],
-                                    ck * gh * co[l],
-                                    ck * gh * s[l],
-                                    ck * gh,
-                                ];
-                                for r in 0..drows {
-                                    w[r][l] = if cut[l] { x[r] } else { 0.0 };
-                                }
+                                gh[l] = if p < 2 { g[l] * dz } else { f * g[l] * dz };
                             }
-                            for (r, wr) in w.iter().enumerate().take(drows) {
-                                add_to(row(d, r0 + r, stride, t), wr);
+                            masked_add(row(d, r0, stride, t), &cut, |l| gh[l] * co[l]);
+                            masked_add(row(d, r0 + 1, stride, t), &cut, |l| gh[l] * s[l]);
+                            if GENERAL {
+                                masked_add(row(d, r0 + 2, stride, t), &cut, |l| sk * gh[l]);
+                                masked_add(row(d, r0 + 3, stride, t), &cut, |l| sk * gh[l] * co[l]);
+                                masked_add(row(d, r0 + 4, stride, t), &cut, |l| sk * gh[l] * s[l]);
+                                masked_add(row(d, r0 + 5, stride, t), &cut, |l| ck * gh[l] * co[l]);
+                                masked_add(row(d, r0 + 6, stride, t), &cut, |l| ck * gh[l] * s[l]);
+                                masked_add(row(d, r0 + 7, stride, t), &cut, |l| ck * gh[l]);
+                            } else {
+                                masked_add(row(d, r0 + 2, stride, t), &cut, |l| gh[l]);
                             }
                         }
                     }

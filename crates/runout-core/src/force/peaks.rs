@@ -39,21 +39,29 @@ pub fn tooth_peaks(series: &ForceSeries, cutter: &Cutter, cut: &Cut) -> Vec<Toot
             own_peak_fxy: series.own_peak_fxy.get(i).copied().unwrap_or(0.0),
         })
         .collect();
+    if k == 0 {
+        return peaks;
+    }
+    // tip angles ψ_i(0), hoisted out of the sample loop (issue 18: the loop was ~10 % of a
+    // `runout simulate`); the same expressions per sample, so the same owner and peaks
+    let tip: Vec<f64> = (0..k).map(|i| cutter.tooth_angle(i, 0.0)).collect();
     for (q, &theta) in series.angle.iter().enumerate() {
-        // the tooth whose tip entered most recently owns this sample
-        let owner = (0..k)
-            .min_by(|&a, &b| {
-                let ra = wrap_tau(theta + cutter.tooth_angle(a, 0.0) - st);
-                let rb = wrap_tau(theta + cutter.tooth_angle(b, 0.0) - st);
-                ra.total_cmp(&rb)
-            })
-            .unwrap_or(0);
+        // the tooth whose tip entered most recently owns this sample (the first on a tie)
+        let mut owner = 0;
+        let mut best = wrap_tau(theta + tip[0] - st);
+        for (i, &t) in tip.iter().enumerate().skip(1) {
+            let r = wrap_tau(theta + t - st);
+            if r.total_cmp(&best).is_lt() {
+                owner = i;
+                best = r;
+            }
+        }
         let f = series.fx[q].hypot(series.fy[q]);
         let p = &mut peaks[owner];
         if f > p.peak_fxy {
             p.peak_fxy = f;
             p.angle = wrap_tau(theta);
-            p.immersion = wrap_tau(theta + cutter.tooth_angle(owner, 0.0));
+            p.immersion = wrap_tau(theta + tip[owner]);
         }
     }
     peaks

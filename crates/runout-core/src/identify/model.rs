@@ -212,7 +212,8 @@ impl RevolutionModel {
         let n = self.grid.len;
         let stride = padded(n);
         let arch = pulp::Arch::new();
-        let run = |mut acc: Acc, disks: std::ops::Range<usize>| {
+        let run = |disks: std::ops::Range<usize>| {
+            let mut acc = Acc::new(stride, GENERAL, np, None);
             dispatch::<ArcGrad, GENERAL, false>(
                 arch,
                 &self.table,
@@ -225,17 +226,15 @@ impl RevolutionModel {
             );
             acc
         };
-        let empty = || Acc::new(stride, GENERAL, np, None);
+        // Disks in contiguous blocks, one kernel dispatch and one accumulator per block, split
+        // and summed exactly as rayon's `fold`/`reduce` over single disks did before (and the
+        // baseline still does): same splitter, same halves, same left + right sums, so the
+        // results are bit-identical to it — without a dispatch per disk and an accumulator per
+        // rayon split.
         let acc = if self.disks >= 8 {
-            (0..self.disks)
-                .into_par_iter()
-                .fold(empty, |acc, j| run(acc, j..j + 1))
-                .reduce(empty, |mut a, b| {
-                    a.add(&b);
-                    a
-                })
+            split_sum(0..self.disks, rayon::current_num_threads(), false, &run)
         } else {
-            run(empty(), 0..self.disks)
+            run(0..self.disks)
         };
         let (rows, drows) = if GENERAL { (NB, ND) } else { (6, 3) };
         let base = (0..n)
@@ -470,6 +469,38 @@ impl RevolutionModel {
             .collect();
         BasisSums { base, deriv }
     }
+}
+
+/// `run` over `disks`, split in halves (at len/2) and the halves run in parallel
+/// ([`rayon::join_context`]) and summed left + right, with the decisions of rayon's adaptive
+/// splitter (`splits` starts at the pool's thread count and halves per split; a half run by
+/// another thread than the one that split resets it to the thread count): the grouping of
+/// `(0..disks).into_par_iter().fold(…).reduce(…)`, with whole blocks as leaves.
+fn split_sum<F>(disks: std::ops::Range<usize>, mut splits: usize, migrated: bool, run: &F) -> Acc
+where
+    F: Fn(std::ops::Range<usize>) -> Acc + Sync,
+{
+    let len = disks.len();
+    let split = len / 2 >= 1
+        && if migrated {
+            splits = rayon::current_num_threads().max(splits / 2);
+            true
+        } else if splits > 0 {
+            splits /= 2;
+            true
+        } else {
+            false
+        };
+    if !split {
+        return run(disks);
+    }
+    let mid = disks.start + len / 2;
+    let (mut a, b) = rayon::join_context(
+        |c| split_sum(disks.start..mid, splits, c.migrated(), run),
+        |c| split_sum(mid..disks.end, splits, c.migrated(), run),
+    );
+    a.add(&b);
+    a
 }
 
 /// Force component `axis` (N) of sample sums `b` with coefficients `kc` (module docs).

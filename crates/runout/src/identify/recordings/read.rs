@@ -187,7 +187,12 @@ pub(super) fn analyse(
 }
 
 /// Pass 1: the source in chunks, mapped to the workpiece frame in N, spilled and fed on.
-fn first_pass<R: BufRead>(
+///
+/// Pipelined (issue 18): a second thread parses the next chunks (up to [`AHEAD`] ahead, their
+/// buffers recycled) while this one maps, spills and averages the current one; chunks arrive
+/// in order and the first read error is returned after the chunks before it, as in a single
+/// loop.
+fn first_pass<R: BufRead + Send>(
     reader: &mut RecordingReader<R>,
     ch: &Channels,
     spill: &mut Spill,
@@ -195,25 +200,70 @@ fn first_pass<R: BufRead>(
     sink: &mut signal::ChunkSink<'_>,
     watch: &mut Watch,
 ) -> Result<()> {
-    let mut chunk = RecordingChunk::default();
-    let mut out = RecordingChunk {
-        values: vec![Vec::new(); 3],
-        ..Default::default()
-    };
-    let has_z = ch.axes.has(FrameAxis::Z);
-    loop {
-        let n = reader.read_chunk(&mut chunk, ROWS)?;
-        if n == 0 {
-            break;
+    use std::sync::mpsc;
+    type Parsed =
+        std::result::Result<(RecordingChunk, usize, u64), runout_io::recording::RecordingError>;
+    std::thread::scope(|scope| {
+        let (full_tx, full_rx) = mpsc::sync_channel::<Parsed>(AHEAD);
+        let (free_tx, free_rx) = mpsc::channel::<RecordingChunk>();
+        for _ in 0..AHEAD + 1 {
+            free_tx.send(RecordingChunk::default()).ok();
         }
+        scope.spawn(move || {
+            // ends at the end of the data, at an error, or when the consumer has stopped
+            while let Ok(mut chunk) = free_rx.recv() {
+                match reader.read_chunk(&mut chunk, ROWS) {
+                    Ok(0) => break,
+                    Ok(n) => {
+                        if full_tx.send(Ok((chunk, n, reader.bytes_read()))).is_err() {
+                            break;
+                        }
+                    }
+                    Err(e) => {
+                        full_tx.send(Err(e)).ok();
+                        break;
+                    }
+                }
+            }
+        });
+        let mut out = RecordingChunk {
+            values: vec![Vec::new(); 3],
+            ..Default::default()
+        };
+        for parsed in full_rx {
+            let (chunk, n, bytes_read) = parsed?;
+            map_chunk(&chunk, n, ch, &mut out, spill, sink, watch)?;
+            progress.set_position(bytes_read);
+            free_tx.send(chunk).ok();
+        }
+        Ok(())
+    })
+}
+
+/// Chunks parsed ahead of the one being mapped and averaged.
+const AHEAD: usize = 2;
+
+/// One parsed chunk of pass 1 (`n` rows): mapped to the workpiece frame in N (`out`), watched, spilled and
+/// fed to the signal pipeline.
+fn map_chunk(
+    chunk: &RecordingChunk,
+    n: usize,
+    ch: &Channels,
+    out: &mut RecordingChunk,
+    spill: &mut Spill,
+    sink: &mut signal::ChunkSink<'_>,
+    watch: &mut Watch,
+) -> Result<()> {
+    let has_z = ch.axes.has(FrameAxis::Z);
+    {
         out.time_s.clone_from(&chunk.time_s); // the spill counts rows by the time column
         out.values.truncate(3);
         let [fx, fy, fz] = &mut out.values[..] else {
             unreachable!("three force columns")
         };
-        ch.axes.map_chunk(&chunk, FrameAxis::X, fx);
-        ch.axes.map_chunk(&chunk, FrameAxis::Y, fy);
-        if !ch.axes.map_chunk(&chunk, FrameAxis::Z, fz) {
+        ch.axes.map_chunk(chunk, FrameAxis::X, fx);
+        ch.axes.map_chunk(chunk, FrameAxis::Y, fy);
+        if !ch.axes.map_chunk(chunk, FrameAxis::Z, fz) {
             fz.clear();
             fz.resize(n, 0.0);
         }
@@ -236,9 +286,8 @@ fn first_pass<R: BufRead>(
         if let Some(i) = ch.pulse {
             out.values.push(chunk.channel(i).to_vec());
         }
-        spill.write(&out)?;
-        sink(as_signal(&out, has_z))?;
-        progress.set_position(reader.bytes_read());
+        spill.write(out)?;
+        sink(as_signal(out, has_z))?;
     }
     Ok(())
 }

@@ -1,0 +1,175 @@
+#!/usr/bin/env python3
+"""Recording ingest of issue 18: `runout identify` on a ~100 MB DynoWare export against
+`pandas.read_csv` of the same file plus a per-column mean, same run.
+
+The file is a Kistler DynoWare text export written by `runout simulate --recording` (the bundled
+example's cut — K 4, Ø10, 30° helix, a_p 2, a_e 2 mm down, 3240 rpm, f_z 0.05, ρ 8 µm at −50°,
+2 % noise, 10 kHz — over enough revolutions for the requested size; generated once into
+`--dir`, default `target/ingest_bench/`). Timed as a user would run them:
+
+* `runout identify FILE --config cut.toml --json -` — the whole job (reading, the three passes of
+  the signal pipeline, the fits), whole process;
+* pandas: `pd.read_csv(FILE, skiprows=<metadata lines and the unit row>, header=0)` (every column
+  float64) then `.mean()` of the force columns —
+  only the parse and a mean, none of the identification (interpreter start and import excluded).
+
+Prints the medians (s), the throughput (MB/s) and the ratio, and the peak resident memory of
+each (`ru_maxrss` of the child process for runout; for pandas a child process running only the
+read, so the interpreter's own footprint is included as a user would see it).
+
+    python3 benches/ingest_vs_pandas.py [--mb 100] [--repeats 5] [--runout PATH] [--dir DIR]
+
+Needs pandas; builds nothing itself (pass --runout or build `target/release/runout` first).
+"""
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+CUT_TOML = """teeth = 4
+diameter_mm = 10.0
+helix_deg = 30.0
+rpm = 3240
+fz_mm = [0.05]
+ap_mm = 2.0
+ae_mm = 2.0
+mode = "down"
+axes = "x = Fx, y = Fy, z = Fz"
+peak_component = "fxy"
+"""
+
+PANDAS_CHILD = r"""
+import resource, sys, time
+import pandas as pd
+path, skip = sys.argv[1], int(sys.argv[2])
+t0 = time.perf_counter()
+# the metadata lines and the DynoWare unit row (s, N, N, N) under the names skipped: all float64
+df = pd.read_csv(path, skiprows=list(range(skip)) + [skip + 1], header=0)
+m = df[["Fx", "Fy", "Fz"]].mean()
+dt = time.perf_counter() - t0
+print(dt, float(m.sum()), resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+"""
+
+
+def generate(runout, path, mb):
+    # one revolution at 10 kHz and 3240 rpm is ≈ 185 rows of ≈ 33 bytes
+    revs = max(20, int(mb * 1e6 / (185 * 33)))
+    cmd = [
+        runout, "simulate", "--teeth", "4", "--diameter-mm", "10", "--helix-deg", "30",
+        "--rpm", "3240", "--fz-mm", "0.05", "--ap-mm", "2", "--ae-mm", "2", "--mode", "down",
+        "--runout-um", "8", "--runout-angle-deg", "-50", "--ktc", "1889.2", "--krc", "806.1",
+        "--kac", "291", "--kte", "63.12", "--kre", "113.7", "--kae", "-3.1",
+        "--revolutions", str(revs), "--disks", "50", "--sample-rate-hz", "10000",
+        "--noise-percent", "2", "--air-cut-s", "0.2", "--seed", "5", "--recording", path,
+    ]
+    subprocess.run(cmd, check=True, capture_output=True)
+
+
+def header_rows(path):
+    """Lines before the column-name row of a DynoWare export (`Time,Fx,…`)."""
+    with open(path, "rb") as f:
+        for n, line in enumerate(f):
+            if line.startswith(b"Time"):
+                return n
+    sys.exit(f"{path}: no `Time,…` column row")
+
+
+def run_timed(cmd, env=None):
+    """Wall time, stdout and peak RSS (KiB) of one child process (`os.wait4`'s own rusage)."""
+    import tempfile
+    with tempfile.TemporaryFile() as out:
+        t0 = time.perf_counter()
+        p = subprocess.Popen(cmd, stdout=out, stderr=subprocess.DEVNULL, env=env)
+        _, status, usage = os.wait4(p.pid, 0)
+        dt = time.perf_counter() - t0
+        p.returncode = os.waitstatus_to_exitcode(status)
+        if p.returncode != 0:
+            sys.exit(f"{' '.join(cmd)}: exit {p.returncode}")
+        out.seek(0)
+        run_timed.cpu = usage.ru_utime + usage.ru_stime
+        return dt, out.read().decode(), usage.ru_maxrss
+
+
+def strip(report):
+    return {k: v for k, v in report.items() if k != "provenance"}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--mb", type=float, default=100.0)
+    ap.add_argument("--repeats", type=int, default=5)
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    ap.add_argument("--runout", default=os.path.join(root, "target", "release", "runout"))
+    ap.add_argument("--baseline", help="another runout binary (e.g. the previous build) timed in the same run")
+    ap.add_argument("--dir", default=os.path.join(root, "target", "ingest_bench"))
+    args = ap.parse_args()
+    if not os.path.exists(args.runout):
+        sys.exit(f"{args.runout}: not found; build it with `cargo build --release -p runout-cli`")
+    try:
+        import pandas as pd
+    except ImportError:
+        sys.exit("needs pandas (pip install pandas)")
+
+    os.makedirs(args.dir, exist_ok=True)
+    path = os.path.join(args.dir, f"cut_{int(args.mb)}MB.txt")
+    if not os.path.exists(path):
+        print(f"generating {path} …", flush=True)
+        generate(args.runout, path, args.mb)
+    toml = os.path.join(args.dir, "cut.toml")
+    with open(toml, "w") as f:
+        f.write(CUT_TOML)
+    size = os.path.getsize(path)
+    skip = header_rows(path)
+
+    def time_runout(binary):
+        cmd = [binary, "identify", path, "--config", toml, "--json", "-"]
+        times, peak, report = [], 0, None
+        cpu = []
+        for _ in range(args.repeats):
+            dt, out, rss = run_timed(cmd)
+            cpu.append(run_timed.cpu)
+            times.append(dt)
+            peak = max(peak, rss)
+            report = json.loads(out)
+        return times, peak, report, statistics.median(cpu)
+
+    rust, rust_rss, report, rust_cpu = time_runout(args.runout)
+    base = time_runout(args.baseline) if args.baseline else None
+    pd_times, pd_rss = [], 0
+    for _ in range(args.repeats):
+        out = subprocess.run(
+            [sys.executable, "-c", PANDAS_CHILD, path, str(skip)],
+            check=True, capture_output=True, text=True,
+        ).stdout.split()
+        pd_times.append(float(out[0]))
+        pd_rss = max(pd_rss, int(out[2]))
+    tr, tp = statistics.median(rust), statistics.median(pd_times)
+    mb = size / 1e6
+    print(f"file: {path}, {mb:.1f} MB; load average {open('/proc/loadavg').read().split()[:3]}")
+    print(f"runout identify (whole job, whole process, median of {len(rust)}): {tr:.3f} s = "
+          f"{mb / tr:.0f} MB/s, CPU {rust_cpu:.3f} s, peak RSS {rust_rss / 1024:.1f} MB")
+    same = None
+    if base is not None:
+        # the full-signal fit sums over disks in rayon's run-dependent grouping: compare the
+        # reports of one-thread runs (fixed order), provenance aside
+        one = dict(os.environ, RAYON_NUM_THREADS="1")
+        rep = [json.loads(run_timed([b, "identify", path, "--config", toml, "--json", "-"], one)[1])
+               for b in (args.runout, args.baseline)]
+        same = strip(rep[0]) == strip(rep[1])
+        tb = statistics.median(base[0])
+        print(f"baseline {args.baseline} (same run): {tb:.3f} s = {mb / tb:.0f} MB/s, CPU {base[3]:.3f} s, "
+              f"peak RSS {base[1] / 1024:.1f} MB; identical reports on one thread (provenance aside): {same}")
+    print(f"pandas {pd.__version__} read_csv + mean (median of {len(pd_times)}): {tp:.3f} s = "
+          f"{mb / tp:.0f} MB/s, peak RSS {pd_rss / 1024:.1f} MB (whole interpreter)")
+    print(f"ratio (wall): runout identify takes {tr / tp:.2f}× the pandas read "
+          f"({'faster' if tr < tp else 'slower'})")
+    if report is not None and "schema" in report:
+        print(f"identify report schema: {report['schema']}")
+
+
+if __name__ == "__main__":
+    main()
