@@ -143,6 +143,7 @@ impl From<&Consequences> for ConsequencesReport {
 /// the angle must be determined for `identified` (ambiguous or undetermined → `partly
 /// identified`, with the reason). `angle = None` means the command does not measure an angle
 /// (heights without angles): the status is then the offset's alone.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn runout_answer(
     method: &str,
     offset_um: f64,
