@@ -416,21 +416,36 @@ pub fn force_magnitude(
     if !(geometry > 0.0 && mean_fxy_n.is_finite() && mean_fxy_n > 0.0) {
         return None;
     }
-    let ktc = mean_fxy_n / geometry;
+    let ktc = (mean_fxy_n / geometry).min(f64::MAX);
     let (lo, hi) = coefficient_range(0, ktc);
     if (lo..=hi).contains(&ktc) {
         return None;
     }
+    // numbers as a user wrote them: plain in the usual range, else with an exponent
+    let g = |v: f64| {
+        if (1e-4..1e6).contains(&v.abs()) {
+            format!("{v}")
+        } else {
+            format!("{v:e}")
+        }
+    };
+    let implied = if ktc.is_finite() && ktc < 1e9 {
+        format!("K_tc ≈ {ktc:.0} N/mm²")
+    } else {
+        format!("K_tc ≈ {ktc:.1e} N/mm²")
+    };
     Some(Finding {
         code: "force_magnitude_contradicts_cut",
         subject: subject.into(),
         message: format!(
             "in {subject} the mean force |F̄_xy| = {mean_fxy_n:.1} N implies a specific cutting \
-             force K_tc ≈ {ktc:.0} N/mm² for {teeth} teeth, a_p {ap_mm} mm, f_z {fz_mm} mm and \
-             immersion {:.1}°–{:.1}° of a {diameter_mm} mm cutter; metals lie in {lo:.0}–{hi:.0} \
-             N/mm²",
+             force {implied} for {teeth} teeth, a_p {} mm, f_z {} mm and immersion \
+             {:.1}°–{:.1}° of a {} mm cutter; metals lie in {lo:.0}–{hi:.0} N/mm²",
+            g(ap_mm),
+            g(fz_mm),
             entry_rad.to_degrees(),
-            exit_rad.to_degrees()
+            exit_rad.to_degrees(),
+            g(diameter_mm)
         ),
         hint: "check --diameter-mm and a_e (they set the immersion), --teeth, a_p and f_z, and \
                the force channels' scale (N per volt, N or kN)"

@@ -163,9 +163,11 @@ pub(crate) fn runout_answer(
         reasons.push(r);
     }
     for f in runout_size(offset_um.abs() * 1e-3, radius_mm, fz_mm.unwrap_or(0.0)) {
+        // no cutter given (heights): the limit is the absolute one, no radius to name
+        let words = f.to_string().replace(" for a cutter of radius inf mm", "");
         match f.severity {
-            Severity::NotIdentified => reasons.push(f.to_string()),
-            Severity::Warning => warnings.push(f.to_string()),
+            Severity::NotIdentified => reasons.push(words),
+            Severity::Warning => warnings.push(words),
         }
     }
     let rho_ok = reasons.is_empty();
