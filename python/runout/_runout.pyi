@@ -56,7 +56,7 @@ def shank_force(
 ) -> Tuple[Report, Optional[Columns]]:
     """Cutting force (N) and runout (µm) from shank displacement sensors (methods.md §3).
 
-    Returns (``runout.shank.force/1``, series): series holds the time series as float64 arrays
+    Returns (``runout.shank.force/2``, series): series holds the time series as float64 arrays
     named as the CLI's CSV columns (``time_s``, forces in N, deflections in mm), or None.
     """
 
@@ -69,7 +69,7 @@ def shank_calibrate(
     load_point_channel: Optional[str] = None,
     sample_rate_hz: Optional[float] = None,
 ) -> Report:
-    """Static calibration of K_δ (N/µm) against a load cell (N). Returns ``runout.shank.calibration/1``."""
+    """Static calibration of K_δ (N/µm) against a load cell (N). Returns ``runout.shank.calibration/2``."""
 
 def displacement_teeth(
     readings: SourceLike,
@@ -89,13 +89,13 @@ def displacement_teeth(
     fz_mm: Optional[float] = None,
     hole_path_mm: Optional[float] = None,
 ) -> Report:
-    """Runout ρ (µm), λ (deg) from per-tooth readings (``tooth``, ``reading_um``). ``runout.displacement.teeth/1``."""
+    """Runout ρ (µm), λ (deg) from per-tooth readings (``tooth``, ``reading_um``). ``runout.displacement.teeth/2``."""
 
 def displacement_heights(
     table: SourceLike, *, at_mm: float = 0.0, method: str = "ols"
 ) -> Report:
     """Runout at several heights (``z_mm``, ``tir_um``/``runout_um``[, ``angle_deg``]) → at ``at_mm`` (mm).
-    ``runout.displacement.heights/1``."""
+    ``runout.displacement.heights/2``."""
 
 def displacement_signal(
     recording: SourceLike,
@@ -119,7 +119,7 @@ def displacement_signal(
     hole_path_mm: Optional[float] = None,
 ) -> Report:
     """Runout vector from a raw displacement signal (``time_s``, ``disp_<name>_um``, ``pulse``…).
-    ``runout.displacement.signal/1``."""
+    ``runout.displacement.signal/2``."""
 
 def grind_compensate(
     probe: SourceLike,
@@ -148,7 +148,7 @@ def grind_compensate(
 ) -> Tuple[Report, Columns, Optional[str]]:
     """Grinding compensation of the bar clamping error (methods.md §5).
 
-    Returns (``runout.grind.compensate/1``, path columns as in ``--path-out`` (mm, µm), the
+    Returns (``runout.grind.compensate/2``, path columns as in ``--path-out`` (mm, µm), the
     compensated NC program text or None).
     """
 
@@ -174,7 +174,7 @@ def grind_check(
     points_per_flute: int = 200,
     edge_phase_deg: float = 0.0,
 ) -> Report:
-    """Simulation check of the grinding compensation (methods.md §5.5). ``runout.grind.check/1``."""
+    """Simulation check of the grinding compensation (methods.md §5.5). ``runout.grind.check/2``."""
 
 def chip_compare(
     config: SourceLike,
@@ -210,7 +210,7 @@ def identify(
     "fs": 10000.0}``); ``config``: cut.toml; ``keys``: config keys overriding it (``fz_mm`` (mm,
     one per recording), ``teeth``, ``diameter_mm``, ``helix_deg``, ``rpm``, ``ap_mm``, ``ae_mm``,
     ``mode``, ``axes``, ``sample_rate_hz`` (Hz), ``chain``, …). Returns
-    ``runout.identify.recording/2`` (the CLI's ``--json``).
+    ``runout.identify.recording/3`` (the CLI's ``--json``).
     """
 
 def simulate(
@@ -244,7 +244,7 @@ def identify_peaks(
     peak_immersion_deg: Optional[float] = None,
     closed_period: bool = False,
 ) -> Report:
-    """Seed-003 sine fit of per-tooth peaks (N). ``runout.identify.peaks/1``."""
+    """Seed-003 sine fit of per-tooth peaks (N). ``runout.identify.peaks/2``."""
 
 def identify_tests(
     table: SourceLike,

@@ -221,7 +221,7 @@ fn shank_stiffness<'py>(
 /// Args: recording (source: path, bytes or arrays, displacement channels in the units the config
 /// names, time `time_s` or a rate `fs` in Hz), config (shank.toml source), sample_rate_hz (Hz,
 /// overrides the file and config), series (return the time series).
-/// Returns (report dict `runout.shank.force/1`, series) where series is a dict of float64 arrays
+/// Returns (report dict `runout.shank.force/2`, series) where series is a dict of float64 arrays
 /// named as the CLI's CSV columns (`time_s`, forces in N, deflections in mm …), or None.
 #[pyfunction]
 #[pyo3(signature = (recording, config, *, sample_rate_hz=None, series=true))]
@@ -270,7 +270,7 @@ fn shank_force<'py>(
 /// Args: recording, config (sources), force_channel (load-cell channel, N, positive towards the
 /// pair's +axis), load_point_mm (constant load distance from the holder face, mm) or
 /// load_point_channel (a channel with it, mm), sample_rate_hz (Hz).
-/// Returns the `runout.shank.calibration/1` report as a dict.
+/// Returns the `runout.shank.calibration/2` report as a dict.
 #[pyfunction]
 #[pyo3(signature = (recording, config, *, force_channel, load_point_mm=None, load_point_channel=None, sample_rate_hz=None))]
 fn shank_calibrate<'py>(
@@ -347,7 +347,7 @@ fn sensor(
 /// ρ at this height and its SE), noise_um (µm, σ of one reading), phase_deg (deg, approximate
 /// runout direction), sensor (`distance` | `radial`), inclination_deg (deg), beam_offset_mm (mm),
 /// fz_mm (mm, feed per tooth), hole_path_mm (mm).
-/// Returns the `runout.displacement.teeth/1` report as a dict (`offset_um`, `angle_deg`, …).
+/// Returns the `runout.displacement.teeth/2` report as a dict (`offset_um`, `angle_deg`, …).
 #[pyfunction]
 #[pyo3(signature = (readings, *, teeth, diameter_mm, helix_deg=0.0, height_mm=0.0, method="joint", offset_um=None, offset_se_um=None, noise_um=None, phase_deg=None, sensor="distance", inclination_deg=0.0, beam_offset_mm=0.0, fz_mm=None, hole_path_mm=None))]
 #[allow(clippy::too_many_arguments)]
@@ -402,7 +402,7 @@ fn displacement_teeth<'py>(
 ///
 /// Args: table (source: `z_mm` and `tir_um` or `runout_um`, optional `angle_deg`), at_mm (mm,
 /// the height wanted, same origin as z), method (`ols` | `eq6`).
-/// Returns the `runout.displacement.heights/1` report as a dict.
+/// Returns the `runout.displacement.heights/2` report as a dict.
 #[pyfunction]
 #[pyo3(signature = (table, *, at_mm=0.0, method="ols"))]
 fn displacement_heights<'py>(
@@ -436,7 +436,7 @@ fn displacement_heights<'py>(
 /// `pulse` | `encoder` | `none`), rpm_min / rpm_max (rpm), surface_diameter_mm (mm),
 /// tooth0_deg (deg), from_s / to_s (s, section), teeth, diameter_mm, helix_deg, height_mm,
 /// sensor, inclination_deg, beam_offset_mm, fz_mm, hole_path_mm.
-/// Returns the `runout.displacement.signal/1` report as a dict.
+/// Returns the `runout.displacement.signal/2` report as a dict.
 #[pyfunction]
 #[pyo3(signature = (recording, *, sensor_angles_deg=None, reference="auto", rpm_min=60.0, rpm_max=60000.0, surface_diameter_mm=None, tooth0_deg=0.0, from_s=None, to_s=None, teeth=None, diameter_mm=None, helix_deg=0.0, height_mm=0.0, sensor="distance", inclination_deg=0.0, beam_offset_mm=0.0, fz_mm=None, hole_path_mm=None))]
 #[allow(clippy::too_many_arguments)]
@@ -572,7 +572,7 @@ fn csv_columns(text: &str) -> anyhow::Result<(Vec<String>, Vec<Vec<f64>>)> {
 /// (mm), flutes, helix_deg (deg), edge_from_mm / edge_to_mm (mm from the tip), points_per_flute,
 /// edge_phase_deg (deg), nc (NC program source), nc_map (`index` | `xyz`), nc_moves (`feed` |
 /// `all`), nc_decimals.
-/// Returns (report dict `runout.grind.compensate/1`, path, nc_text): path is a dict of float64
+/// Returns (report dict `runout.grind.compensate/2`, path, nc_text): path is a dict of float64
 /// arrays with the columns of the CLI's `--path-out` CSV (mm, µm), nc_text the compensated
 /// program (or None).
 #[pyfunction]
@@ -716,7 +716,7 @@ fn grind_compensate<'py>(
 /// angles, u_from_mm / u_to_mm (mm from the tip), noise_um (µm), draws, seed, outside, edge
 /// (`flat` | `ball`), edge_diameter_mm, flutes, helix_deg, edge_from_mm, edge_to_mm,
 /// points_per_flute, edge_phase_deg.
-/// Returns the `runout.grind.check/1` report as a dict.
+/// Returns the `runout.grind.check/2` report as a dict.
 #[pyfunction]
 #[pyo3(signature = (*, bar_diameter_mm=6.0, offset_um=(8.0, -4.0), tilt_um_per_mm=(0.3, 0.5), layers=5, angles=8, u_from_mm=2.0, u_to_mm=28.0, noise_um=0.0, draws=1, seed=1, outside="clamp", edge="flat", edge_diameter_mm=None, flutes=4, helix_deg=30.0, edge_from_mm=0.0, edge_to_mm=None, points_per_flute=200, edge_phase_deg=0.0))]
 #[allow(clippy::too_many_arguments)]
@@ -937,7 +937,7 @@ fn sources(py: Python<'_>, obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<S
 /// argument overriding the config (`fz_mm=[0.05, 0.08]` (mm, one per recording), `teeth`,
 /// `diameter_mm`, `helix_deg` (deg), `rpm`, `ap_mm`, `ae_mm`, `mode`, `axes`,
 /// `sample_rate_hz` (Hz), `chain`, …).
-/// Returns the `runout.identify.recording/2` report as a dict (`full_signal.offset_um`, …).
+/// Returns the `runout.identify.recording/3` report as a dict (`full_signal.offset_um`, …).
 #[pyfunction]
 #[pyo3(signature = (recordings, config=None, **keys))]
 fn identify<'py>(
@@ -1024,7 +1024,7 @@ fn hypothesis(closed_period: bool) -> runout_core::identify::SineHypothesis {
 /// Args: peaks_N (per-tooth peak forces, N, teeth in cutting order), fz_mm (mm), peaks_se_N
 /// (N), mode (`up` | `down` | `slot`), ae_mm (mm), diameter_mm (mm), peak_immersion_deg (deg),
 /// closed_period (K + 1 points, the seed's Table 2).
-/// Returns the `runout.identify.peaks/1` report as a dict.
+/// Returns the `runout.identify.peaks/2` report as a dict.
 #[pyfunction]
 #[pyo3(signature = (peaks_N, *, fz_mm, peaks_se_N=None, mode="up", ae_mm=None, diameter_mm=None, peak_immersion_deg=None, closed_period=false))]
 #[allow(non_snake_case, clippy::too_many_arguments)]

@@ -20,7 +20,7 @@ def dynoware_arrays(path):
 
 def test_identify_equals_cli(cli):
     got = runout.identify(RECS, config=CONFIG)
-    assert got["schema"] == "runout.identify.recording/2"
+    assert got["schema"] == "runout.identify.recording/3"
     assert got == cli.json("identify", *RECS, "--config", CONFIG)
     fit = got["full_signal"]
     # the example's known runout: 8 µm at −50° (examples/identify/README.md)
@@ -40,7 +40,7 @@ def test_identify_from_bytes_and_arrays():
     a, b = got["full_signal"], ref["full_signal"]
     for k in ["offset_um", "offset_um_se", "angle_deg", "angle_deg_se", "r_squared"]:
         assert a[k] == pytest.approx(b[k], rel=1e-9, abs=1e-12), k
-    assert got["recordings"][0]["format"] == "Arrays"
+    assert got["recordings"][0]["format"] == "arrays"
     assert got["recordings"][0]["samples"] == ref["recordings"][0]["samples"]
 
 

@@ -124,7 +124,7 @@ def test_displacement_heights_from_arrays_equals_cli_on_the_file(cli, tmp_path):
     assert runout.displacement_heights(p, at_mm=2) == want
     # integer and float32 arrays are converted to float64
     got = runout.displacement_heights({"z_mm": z.astype(np.int64), "tir_um": tir.astype(np.float32)})
-    assert got["schema"] == "runout.displacement.heights/1"
+    assert got["schema"] == "runout.displacement.heights/2"
 
 
 def test_displacement_teeth_from_arrays(cli, tmp_path):

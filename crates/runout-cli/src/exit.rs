@@ -35,3 +35,10 @@ pub const HELP: &str =
     "Exit status: 0 identified (or nothing to identify); 3 ran, but the result is \
 not (fully) identified (the report says which part and why); 1 error in the input or data; 2 usage \
 error; 141 output pipe closed early.";
+
+/// Exit with [`NOT_IDENTIFIED`] unless the report's answer is `identified`.
+pub fn from_answer<R: runout::answer::Answered>(report: &R) {
+    if !report.answer().is_identified() {
+        not_identified();
+    }
+}

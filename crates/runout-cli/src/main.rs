@@ -19,6 +19,10 @@ use std::process::ExitCode;
 #[derive(Parser, Debug)]
 #[command(name = "runout", version, about, long_about = None, after_help = exit::HELP)]
 struct Cli {
+    /// No progress bars or spinners and no warnings on stderr (errors only); the warnings stay
+    /// in the report (text and JSON).
+    #[arg(long, short = 'q', global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -87,6 +91,7 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
 fn main() -> ExitCode {
     quiet_on_broken_pipe();
     let cli = Cli::parse();
+    progress::set_quiet(cli.quiet);
     // the program by its name, not the path it was started from (the same on every machine)
     let args: Vec<String> = std::env::args()
         .enumerate()

@@ -1,7 +1,52 @@
 //! The library's progress reports ([`runout::Progress`]) as indicatif bars on stderr (hidden
-//! when stderr is not a terminal).
+//! when stderr is not a terminal, and with `--quiet`), and the warnings on stderr (none with
+//! `--quiet`: they stay in the report).
 
 use indicatif::{ProgressBar, ProgressStyle};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+static QUIET: AtomicBool = AtomicBool::new(false);
+
+/// `--quiet`: no progress bars or spinners, no warnings on stderr (errors only).
+pub fn set_quiet(quiet: bool) {
+    QUIET.store(quiet, Ordering::Relaxed);
+}
+
+/// Whether `--quiet` was given.
+pub fn quiet() -> bool {
+    QUIET.load(Ordering::Relaxed)
+}
+
+/// A warning on stderr, unless `--quiet` (the report keeps it either way).
+pub fn warn(message: &str) {
+    if !quiet() {
+        eprintln!("warning: {message}");
+    }
+}
+
+/// A spinner on stderr for a job without a byte count (hidden when stderr is not a terminal or
+/// with `--quiet`); cleared when dropped.
+pub struct Spinner(ProgressBar);
+
+impl Spinner {
+    /// Start a spinner with `message`.
+    pub fn new(message: &str) -> Self {
+        let bar = if quiet() {
+            ProgressBar::hidden()
+        } else {
+            ProgressBar::new_spinner()
+        };
+        bar.set_message(message.to_string());
+        bar.enable_steady_tick(std::time::Duration::from_millis(120));
+        Spinner(bar)
+    }
+}
+
+impl Drop for Spinner {
+    fn drop(&mut self) {
+        self.0.finish_and_clear();
+    }
+}
 
 /// One bar per stage, in bytes of input.
 #[derive(Default)]
@@ -11,7 +56,11 @@ pub struct Bars {
 
 impl runout::Progress for Bars {
     fn begin(&mut self, stage: &str, total_bytes: Option<u64>) {
-        let bar = ProgressBar::new(total_bytes.unwrap_or(0));
+        let bar = if quiet() {
+            ProgressBar::hidden()
+        } else {
+            ProgressBar::new(total_bytes.unwrap_or(0))
+        };
         bar.set_style(
             ProgressStyle::with_template(
                 "{msg} [{bar:40}] {bytes}/{total_bytes} ({bytes_per_sec}, {eta})",

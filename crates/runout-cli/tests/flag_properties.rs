@@ -77,11 +77,12 @@ fn check(base: &[String], flag: &str, value: &str) {
     }
 }
 
-/// The unchanged invocation works (so a refusal is the flag's doing).
+/// The unchanged invocation works (so a refusal is the flag's doing); 3 = ran, not (fully)
+/// identified (issue 21: the 3-tooth readings without an SE).
 fn base_succeeds(base: &[String]) {
     let out = runout().args(base).output().unwrap();
     assert!(
-        out.status.success(),
+        matches!(out.status.code(), Some(0 | 3)),
         "{base:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );

@@ -53,7 +53,7 @@ fn compensates_the_example_program() {
     runout().args(&args).assert().success();
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    assert_eq!(r["schema"], "runout.grind.compensate/1");
+    assert_eq!(r["schema"], "runout.grind.compensate/2");
     let off = &r["axis"]["offset_at_u0_um"];
     assert!(
         (off[0].as_f64().unwrap() - 8.0).abs() < 0.5
@@ -267,7 +267,7 @@ fn check_reproduces_the_methods_table() {
             .stdout
             .clone();
         let r: serde_json::Value = serde_json::from_slice(&o).unwrap();
-        assert_eq!(r["schema"], "runout.grind.check/1");
+        assert_eq!(r["schema"], "runout.grind.check/2");
         let b = &r["bilinear"];
         let (br, bx) = (
             b["interpolation_rms_um"].as_f64().unwrap(),
@@ -327,7 +327,8 @@ fn probe_angle_sense() {
                 "-",
             ])
             .assert()
-            .success()
+            // two layers: the axis has no SE, partly identified (issue 21: exit 3)
+            .code(3)
             .get_output()
             .stdout
             .clone();
@@ -340,7 +341,7 @@ fn probe_angle_sense() {
         assert!((ax["runout_angle_deg"].as_f64().unwrap() + want).abs() < 1e-3);
         assert!((ax["offset_um"].as_f64().unwrap() - 10.0).abs() < 1e-3);
         // two layers: no standard errors
-        assert!(ax["offset_se_um"].is_null());
+        assert!(ax["offset_um_se"].is_null());
     }
 }
 

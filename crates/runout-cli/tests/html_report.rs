@@ -19,8 +19,10 @@ fn run(args: &[&str]) {
         .args(args)
         .output()
         .unwrap();
+    // 3: ran, not (fully) identified (the 3-tooth readings without an SE): the outputs are
+    // written all the same (issue 21)
     assert!(
-        out.status.success(),
+        matches!(out.status.code(), Some(0 | 3)),
         "{args:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );

@@ -35,7 +35,7 @@ fn peaks_json_matches_section_7_vectors() {
     let mut args = PEAKS.to_vec();
     args.extend(["--peaks-N", "366.6,307.9,259.9,326.6", "--json", "-"]);
     let j = json_of(&args);
-    assert_eq!(j["schema"], "runout.identify.peaks/1");
+    assert_eq!(j["schema"], "runout.identify.peaks/2");
     // H0 (K peaks): C 315.25, A 54.16, φ 99.94°, R² 0.9973 (methods.md §7)
     let f = |k: &str| j[k].as_f64().unwrap_or_else(|| panic!("{k}: {j}"));
     assert!((f("mean_N") - 315.25).abs() < 0.006);

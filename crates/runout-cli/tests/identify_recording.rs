@@ -36,7 +36,7 @@ fn bundled_example_recovers_the_known_runout_and_coefficients() {
         String::from_utf8_lossy(&out.stderr)
     );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["schema"], "runout.identify.recording/2");
+    assert_eq!(v["schema"], "runout.identify.recording/3");
     let f = &v["full_signal"];
     // truth: ρ 8 µm at λ −50°; 2 % noise on 18 averaged revolutions gives SE ≈ 0.05 µm / 0.3°, so
     // 0.3 µm and 1.5° are ≥ 5 SE (the round-trip bound for ρ).

@@ -293,7 +293,7 @@ fn force_runout_and_validation_from_a_csv_recording() {
             plots.to_str().unwrap(),
         ],
     );
-    assert_eq!(j["schema"], "runout.shank.force/1");
+    assert_eq!(j["schema"], "runout.shank.force/2");
     // validation against the true force: within 2 % RMS, correlation > 0.999
     for v in j["validation"]["per_axis"].as_array().unwrap() {
         assert!(v["relative_rms_error"].as_f64().unwrap() < 0.02, "{v}");
@@ -389,7 +389,7 @@ fn dynoware_input_with_decimal_commas_gives_the_same_force() {
     let rec = dir.path().join("rec.txt");
     fs::write(&rec, buf).unwrap();
     let j = force_json(&rec, &config(dir.path(), ""), &[]);
-    assert!(j["format"].as_str().unwrap().contains("DynoWare"));
+    assert!(j["format"].as_str().unwrap().contains("dynoware"));
     for v in j["validation"]["per_axis"].as_array().unwrap() {
         assert!(v["relative_rms_error"].as_f64().unwrap() < 0.02, "{v}");
     }
@@ -546,7 +546,7 @@ fn static_calibration_from_a_load_recording() {
     let truth = held.stiffness_n_per_um();
     let (k_fit, se) = (
         j["stiffness_N_per_um"].as_f64().unwrap(),
-        j["stiffness_se_N_per_um"].as_f64().unwrap(),
+        j["stiffness_N_per_um_se"].as_f64().unwrap(),
     );
     assert!(
         (k_fit - truth).abs() < 4.0 * se && se < 0.002 * truth,

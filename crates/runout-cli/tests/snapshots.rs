@@ -25,8 +25,9 @@ fn run(args: &[&str], tmp: &Path) -> String {
         .args(args)
         .output()
         .unwrap();
+    // 0 identified, 3 ran but not (fully) identified: the answer's status is in the snapshot
     assert!(
-        out.status.success(),
+        matches!(out.status.code(), Some(0 | 3)),
         "{args:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );

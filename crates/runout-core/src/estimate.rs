@@ -20,6 +20,7 @@ pub struct Estimate {
     /// The estimate.
     pub value: f64,
     /// Its standard error, if available.
+    #[serde(rename = "value_se")]
     pub se: Option<f64>,
 }
 

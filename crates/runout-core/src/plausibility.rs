@@ -369,3 +369,87 @@ pub fn sensor_senses(a: &[f64], b: &[f64], axis: &str) -> Option<Finding> {
 pub fn worst(findings: &[Finding]) -> Option<Severity> {
     findings.iter().map(|f| f.severity).max()
 }
+
+/// Ratio K_rc/K_tc assumed by [`force_magnitude`]: the middle of the 0.3–0.7 typical of metals
+/// (the result depends on it only through √(1 + r²): ±8 % over that range).
+pub const FORCE_MAGNITUDE_RADIAL_RATIO: f64 = 0.5;
+
+/// The forces' magnitude against the cut's description (issue 21: a wrong `--diameter-mm`,
+/// teeth or force scale). The mean force over a revolution of the shear forces is
+/// (docs/methods.md §0, with h = f_z·sin φ; Altintas, *Manufacturing Automation*, eq. 2.17)
+///
+/// F̄_x = K·a_p·f_z/(8π)·[K_tc·cos 2φ − K_rc·(2φ − sin 2φ)], F̄_y = K·a_p·f_z/(8π)·[K_tc·(2φ − sin 2φ) + K_rc·cos 2φ]
+/// evaluated from φ_st to φ_ex, so |F̄_xy| = K·a_p·f_z/(8π)·K_tc·√(1 + r²)·√(A² + B²) with
+/// A = [cos 2φ], B = [2φ − sin 2φ] and r = K_rc/K_tc. The measured |F̄_xy| thus implies
+/// K_tc; outside the range published for metals (200–8 000 N/mm², module docs) the description
+/// of the cut contradicts the forces: the immersion (diameter and a_e), the teeth, a_p, f_z, or
+/// the force channels' scale. Edge forces add to |F̄_xy| (the implied K_tc is an upper bound at
+/// small f_z), so only a value outside the range is reported, as a warning.
+///
+/// ```
+/// use runout_core::plausibility::force_magnitude;
+/// use std::f64::consts::PI;
+/// // 4 teeth, a_p 3 mm, f_z 0.05 mm, a_e 2 mm of a 10 mm cutter (down milling): φ 126.9°–180°
+/// let (st, ex) = (PI - 0.6f64.acos(), PI);
+/// // about 2 000 N/mm²: |F̄| ≈ 4·3·0.05/(8π)·2000·√1.25·√(A²+B²)
+/// assert!(force_magnitude("a", 100.0, 4, 3.0, 0.05, st, ex, 10.0).is_none());
+/// // the same mean force told a 100 mm cutter: φ_st 163.7°, the implied K_tc is far too large
+/// let st100 = PI - 0.96f64.acos();
+/// assert!(force_magnitude("a", 100.0, 4, 3.0, 0.05, st100, ex, 100.0).is_some());
+/// ```
+#[allow(clippy::too_many_arguments)]
+pub fn force_magnitude(
+    subject: &str,
+    mean_fxy_n: f64,
+    teeth: usize,
+    ap_mm: f64,
+    fz_mm: f64,
+    entry_rad: f64,
+    exit_rad: f64,
+    diameter_mm: f64,
+) -> Option<Finding> {
+    let a = (2.0 * exit_rad).cos() - (2.0 * entry_rad).cos();
+    let b = (2.0 * exit_rad - (2.0 * exit_rad).sin()) - (2.0 * entry_rad - (2.0 * entry_rad).sin());
+    let geometry = teeth as f64 * ap_mm * fz_mm / (8.0 * std::f64::consts::PI)
+        * (1.0 + FORCE_MAGNITUDE_RADIAL_RATIO.powi(2)).sqrt()
+        * a.hypot(b);
+    if !(geometry > 0.0 && mean_fxy_n.is_finite() && mean_fxy_n > 0.0) {
+        return None;
+    }
+    let ktc = (mean_fxy_n / geometry).min(f64::MAX);
+    let (lo, hi) = coefficient_range(0, ktc);
+    if (lo..=hi).contains(&ktc) {
+        return None;
+    }
+    // numbers as a user wrote them: plain in the usual range, else with an exponent
+    let g = |v: f64| {
+        if (1e-4..1e6).contains(&v.abs()) {
+            format!("{v}")
+        } else {
+            format!("{v:e}")
+        }
+    };
+    let implied = if ktc.is_finite() && ktc < 1e9 {
+        format!("K_tc ≈ {ktc:.0} N/mm²")
+    } else {
+        format!("K_tc ≈ {ktc:.1e} N/mm²")
+    };
+    Some(Finding {
+        code: "force_magnitude_contradicts_cut",
+        subject: subject.into(),
+        message: format!(
+            "in {subject} the mean force |F̄_xy| = {mean_fxy_n:.1} N implies a specific cutting \
+             force {implied} for {teeth} teeth, a_p {} mm, f_z {} mm and immersion \
+             {:.1}°–{:.1}° of a {} mm cutter; metals lie in {lo:.0}–{hi:.0} N/mm²",
+            g(ap_mm),
+            g(fz_mm),
+            entry_rad.to_degrees(),
+            exit_rad.to_degrees(),
+            g(diameter_mm)
+        ),
+        hint: "check --diameter-mm and a_e (they set the immersion), --teeth, a_p and f_z, and \
+               the force channels' scale (N per volt, N or kN)"
+            .into(),
+        severity: Severity::Warning,
+    })
+}

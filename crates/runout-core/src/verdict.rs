@@ -171,7 +171,7 @@ pub fn verdict(input: &VerdictInput) -> Result<Verdict, ParamError> {
     if let Some(s) = se {
         if !(s.is_finite() && s >= 0.0) {
             return Err(ParamError::new(
-                "offset_se_um",
+                "offset_um_se",
                 "a finite SE >= 0 µm",
                 s * 1e3,
             ));
@@ -430,7 +430,7 @@ mod tests {
         assert!(verdict(&i)
             .unwrap_err()
             .to_string()
-            .contains("offset_se_um"));
+            .contains("offset_um_se"));
         assert!(axis_split([0.0; 2], [0.0; 2], 0.0)
             .unwrap_err()
             .to_string()

@@ -20,6 +20,7 @@
 //! # Ok::<(), anyhow::Error>(())
 //! ```
 
+pub mod answer;
 pub mod batch;
 pub mod case;
 pub mod chip;

@@ -22,7 +22,8 @@ pub struct VerdictBasis {
     /// Identified offset ρ (µm) at `height_mm`.
     pub offset_um: f64,
     /// Its standard error (µm), if known.
-    pub offset_se_um: Option<f64>,
+    #[serde(alias = "offset_se_um")]
+    pub offset_um_se: Option<f64>,
     /// Its angle λ (deg from tooth 0 in the direction of rotation), if determined; without it the
     /// per-tooth consequences cannot be assigned to teeth and are left out.
     pub angle_deg: Option<f64>,
@@ -110,7 +111,8 @@ pub struct VerdictReport {
     /// Total indicated runout TIR = 2ρ (µm).
     pub tir_um: f64,
     /// Standard error of the TIR (µm).
-    pub tir_se_um: Option<f64>,
+    #[serde(alias = "tir_se_um")]
+    pub tir_um_se: Option<f64>,
     /// Tolerance on the TIR (µm).
     pub tolerance_tir_um: f64,
     /// `given`, or the standard the default comes from.
@@ -150,7 +152,7 @@ impl VerdictReport {
         let rho = basis.offset_um.max(0.0) * 1e-3;
         let v = verdict(&VerdictInput {
             runout: Runout::new(rho, basis.angle_deg.unwrap_or(0.0).to_radians())?,
-            offset_se_mm: basis.offset_se_um.map(|s| s * 1e-3),
+            offset_se_mm: basis.offset_um_se.map(|s| s * 1e-3),
             cutter: cutter.clone(),
             height_mm: basis.height_mm,
             fz_mm: basis.fz_mm,
@@ -171,7 +173,7 @@ impl VerdictReport {
         let mut r = Self {
             status: v.status.as_str().into(),
             tir_um: v.tir_mm * 1e3,
-            tir_se_um: um(v.tir_se_mm),
+            tir_um_se: um(v.tir_se_mm),
             tolerance_tir_um: v.tolerance_tir_mm * 1e3,
             tolerance_source: source.into(),
             slot_oversize_um: v.slot_oversize_mm * 1e3,
@@ -216,7 +218,7 @@ impl VerdictReport {
     fn words(&self) -> Vec<String> {
         let mut w = Vec::new();
         let se = self
-            .tir_se_um
+            .tir_um_se
             .map_or(String::new(), |s| format!(" ± {s:.2}"));
         let tol = format!(
             "the tolerance {:.1} µm TIR ({})",
@@ -367,7 +369,7 @@ mod tests {
     fn basis() -> VerdictBasis {
         VerdictBasis {
             offset_um: 10.0,
-            offset_se_um: Some(0.5),
+            offset_um_se: Some(0.5),
             angle_deg: Some(0.0),
             teeth: Some(4),
             diameter_mm: Some(10.0),
@@ -382,7 +384,7 @@ mod tests {
         let v = VerdictReport::new(basis(), None).unwrap();
         assert_eq!(v.status, "fail");
         assert!((v.tir_um - 20.0).abs() < 1e-12);
-        assert_eq!(v.tir_se_um, Some(1.0));
+        assert_eq!(v.tir_um_se, Some(1.0));
         assert_eq!(v.tolerance_tir_um, 10.0);
         assert_eq!(v.most_loaded_tooth, Some(3));
         assert!((v.teeth[0].radius_deviation_um - 10.0).abs() < 1e-9);

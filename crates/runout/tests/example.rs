@@ -71,7 +71,7 @@ fn identify_example_gives_the_cli_numbers() {
 fn shank_force_example_recovers_the_runout() {
     one_thread();
     let r = example::run().unwrap();
-    assert_eq!(r.schema, "runout.shank.force/1");
+    assert_eq!(r.schema, "runout.shank.force/2");
     assert_eq!(r.recording, "synthetic.csv");
     // 10 µm at the tip, no tilt (noise-free, 5-decimal µm CSV)
     assert!(

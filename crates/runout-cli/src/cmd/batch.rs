@@ -108,11 +108,18 @@ pub fn run(a: Args) -> Result<()> {
         retry_errors: a.retry_errors,
         parquet,
     };
+    // one step per recording (hidden when stderr is not a terminal, and with --quiet)
+    let bar = if crate::progress::quiet() {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(req.files.len() as u64)
+    };
     let report = batch::run(
         &req,
         |p: &Path| identify_row(&exe, p, &a.config, &a.identify_flags),
-        &|_| {},
+        &|_| bar.inc(1),
     )?;
+    bar.finish_and_clear();
     let json_on_stdout = a.json.as_deref() == Some(Path::new("-"));
     if let Some(j) = &a.json {
         crate::output::write_text(j, &runout::to_json(&report)?)?;

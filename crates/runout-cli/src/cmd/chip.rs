@@ -136,14 +136,16 @@ fn check_outputs(outputs: &[&Option<PathBuf>], inputs: &[PathBuf]) -> Result<()>
 }
 
 fn compare(a: CompareArgs) -> Result<()> {
+    let spin = crate::progress::Spinner::new("comparing the chip models");
     let report = compare_job(&CompareRequest {
         config: case_file(&a.config, &a.config_flag)?,
         case: a.case.clone(),
         phase_refinement: !a.no_phase_refinement,
         fit_k: a.fit_k,
     })?;
+    drop(spin);
     for w in &report.warnings {
-        eprintln!("warning: {w}");
+        crate::progress::warn(w);
     }
     check_outputs(&[&a.json, &a.report.html], &report.inputs)?;
     a.report.write(&report)?;
@@ -170,16 +172,18 @@ fn eval(a: EvalArgs) -> Result<()> {
         .transpose()?
         .unwrap_or(ModelArg::Exact)
         .into();
+    let spin = crate::progress::Spinner::new("evaluating the chip thickness");
     let report = eval_job(&EvalRequest {
         config: case_file(&a.config, &a.config_flag)?,
         case: a.case.clone(),
         model,
     })?;
+    drop(spin);
     let plot = a.plots.file("chip_angle");
     let map = a.map.clone().or_else(|| a.plots.in_dir("chip_map"));
     check_outputs(&[&a.out, &plot, &map, &a.json], &report.detail.inputs)?;
     for w in &report.warnings {
-        eprintln!("warning: {w}");
+        crate::progress::warn(w);
     }
     if let Some(out) = &a.out {
         render::eval_csv(output::create(out)?, &report)?;

@@ -17,7 +17,7 @@ pub struct Args {
     /// Sample rate (Hz), for a text recording with neither a time column nor a sampling-rate line.
     #[arg(long)]
     pub sample_rate_hz: Option<f64>,
-    /// Print JSON (schema runout.inspect/1, to stdout) instead of a table.
+    /// Print JSON (schema runout.inspect/2, to stdout) instead of a table.
     #[arg(long)]
     pub json: bool,
 }

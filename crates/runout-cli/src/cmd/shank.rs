@@ -233,6 +233,7 @@ fn force(a: ForceArgs) -> Result<()> {
     }
     let mut report = shank::force_to(&req, writer, &mut crate::progress::Bars::default())?;
     a.report.judge(&mut report)?;
+    crate::exit::from_answer(&report);
     a.report.write(&report)?;
     if let Some(p) = &a.json {
         output::write_text(p, &crate::provenance::stamped_json(&report)?)?;
@@ -270,6 +271,7 @@ fn calibrate(a: CalibrateArgs) -> Result<()> {
         )?,
     };
     let report = shank::calibrate(&req)?;
+    crate::exit::from_answer(&report);
     if let Some(pj) = &a.json {
         output::check_not_input(pj, &[&a.recording, &a.config])?;
     }

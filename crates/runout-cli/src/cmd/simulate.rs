@@ -220,7 +220,9 @@ pub fn run(a: Args) -> Result<()> {
     let inputs: Vec<&Path> = req.inputs.iter().map(|p| p.as_path()).collect();
     let plot = a.plots.file("forces");
     crate::flags::check_outputs([&a.out, &a.json, &plot, &r.recording], &inputs)?;
+    let spin = crate::progress::Spinner::new("simulating");
     let report = simulate(&req)?;
+    drop(spin);
     if let Some(out) = &a.out {
         render::forces_csv(output::create(out)?, &report)?;
     }

@@ -63,7 +63,7 @@ impl AngleEstimate {
         match se_rad {
             Some(se) if se.is_nan() || se >= ANGLE_SE_LIMIT_RAD => AngleEstimate::Undetermined {
                 reason: format!(
-                    "offset {:.4} µm is too small for the noise: σ_λ = {:.1}° exceeds the 10° limit of methods.md §1.5",
+                    "offset {:.4} µm is too small for the noise: σ_λ = {:.1}° exceeds the 10° limit of docs/methods.md §1.5",
                     offset_mm * 1e3,
                     se.to_degrees()
                 ),

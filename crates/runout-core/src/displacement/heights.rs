@@ -125,7 +125,7 @@ pub fn runout_at_height(
                 ));
             }
             let at = rbar - (zbar - z_c_mm) * srr / szr;
-            notes.push("seed eq. (6) (reverse regression) is biased with noisy r; prefer OLS (methods.md §1.3)".into());
+            notes.push("seed eq. (6) (reverse regression) is biased with noisy r; prefer OLS (docs/methods.md §1.3)".into());
             (at, srr / szr, None, None)
         }
     };

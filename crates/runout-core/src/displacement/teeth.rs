@@ -389,7 +389,7 @@ fn two_teeth(
     }
     let rho = required_offset(
         opts,
-        "K = 2 gives one equation for two unknowns (methods.md §1.5)",
+        "K = 2 gives one equation for two unknowns (docs/methods.md §1.5)",
     )?;
     let (z, r) = (opts.height_mm, cutter.radius_at(opts.height_mm));
     let p = readings.positions();
@@ -506,7 +506,7 @@ fn resolve_mirror(
     if let Some(s) = se.filter(|s| s.is_nan() || *s >= super::ANGLE_SE_LIMIT_RAD) {
         return AngleEstimate::Undetermined {
             reason: format!(
-                "K = 2: σ_λ = {:.1}° exceeds the 10° limit (θ' = {:.1}° is near 0° or 180°, where dθ/dΔR → ∞, or the offset {:.3} µm is too small for the noise; methods.md §1.5)",
+                "K = 2: σ_λ = {:.1}° exceeds the 10° limit (θ' = {:.1}° is near 0° or 180°, where dθ/dΔR → ∞, or the offset {:.3} µm is too small for the noise; docs/methods.md §1.5)",
                 s.to_degrees(),
                 theta.to_degrees(),
                 rho * 1e3

@@ -14,7 +14,7 @@ pub enum IdentifyError {
     #[error(
         "the per-tooth sine fit is degenerate for K = 2: only the mean C = {mean_n:.3} N and \
          A·sin(φ) = {a_sin_phi_n:.3} N are observable (offset and angle cannot be separated; \
-         methods.md §4.2). Use the full-signal identification (identify::full_signal), which \
+         docs/methods.md §4.2). Use the full-signal identification (`runout identify RECORDING…`), which \
          works for K = 2"
     )]
     DegenerateTwoTeeth {

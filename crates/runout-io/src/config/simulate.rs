@@ -134,7 +134,7 @@ pub const SIMULATE_KEYS: &[(&str, Quantity, &str)] = &[
     (
         "chip_model",
         Quantity::Dimensionless,
-        "chip-thickness model: arc | exact | equivalent (methods.md §2) [default arc]",
+        "chip-thickness model: arc | exact | equivalent (docs/methods.md §2) [default arc]",
     ),
 ];
 

@@ -54,6 +54,11 @@ fn draw_heat<DB: DrawingBackend>(
         "bar deviation δ (seed, max |δ| = {:.2} µm; red outward, blue inward)",
         scale * 1e3
     );
+    // the map and its colour bar (δ in µm, −max … +max)
+    let (width, _) = root.dim_in_pixel();
+    let (root, bar) = root.split_horizontally(width.saturating_sub(110));
+    draw_deviation_bar(&bar, scale * 1e3)?;
+    let root = &root;
     let mut chart = ChartBuilder::on(root)
         .caption(title, ("sans-serif", 18))
         .margin(12)
@@ -104,6 +109,38 @@ fn draw_heat<DB: DrawingBackend>(
             )
             .map_err(e2s)?;
     }
+    Ok(())
+}
+
+/// The colour bar of the deviation heat map: δ from −`max_um` (blue, inward) to +`max_um` (red,
+/// outward), labelled `δ (µm)`.
+fn draw_deviation_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    max_um: f64,
+) -> Result<(), String> {
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(50)
+        .margin_bottom(52)
+        .margin_right(8)
+        .y_label_area_size(55)
+        .caption("δ (µm)", ("sans-serif", 14))
+        .build_cartesian_2d(0.0..1.0, -max_um..max_um)
+        .map_err(e2s)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .draw()
+        .map_err(e2s)?;
+    let n = 100;
+    chart
+        .draw_series((0..n).map(|q| {
+            let lo = -max_um + 2.0 * max_um * q as f64 / n as f64;
+            let hi = -max_um + 2.0 * max_um * (q + 1) as f64 / n as f64;
+            let c = diverging(0.5 * (lo + hi) / max_um);
+            Rectangle::new([(0.0, lo), (1.0, hi)], c.filled())
+        }))
+        .map_err(e2s)?;
     Ok(())
 }
 

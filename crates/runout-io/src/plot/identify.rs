@@ -242,9 +242,9 @@ pub struct RunoutMark<'a> {
     /// Angle λ (deg).
     pub angle_deg: f64,
     /// Standard error of ρ (µm); NaN if unknown.
-    pub offset_se_um: f64,
+    pub offset_um_se: f64,
     /// Standard error of λ (deg); NaN if unknown.
-    pub angle_se_deg: f64,
+    pub angle_deg_se: f64,
 }
 
 /// Polar plot of runout vectors with their uncertainty sectors; tooth directions marked.
@@ -270,8 +270,8 @@ fn draw_polar<DB: DrawingBackend>(
         .iter()
         .map(|m| {
             m.offset_um
-                + if m.offset_se_um.is_finite() {
-                    m.offset_se_um
+                + if m.offset_um_se.is_finite() {
+                    m.offset_um_se
                 } else {
                     0.0
                 }
@@ -342,12 +342,12 @@ fn draw_polar<DB: DrawingBackend>(
     }
     for (q, m) in marks.iter().enumerate() {
         let col = colour(q + 3);
-        if m.offset_se_um.is_finite() && m.angle_se_deg.is_finite() {
+        if m.offset_um_se.is_finite() && m.angle_deg_se.is_finite() {
             let (r0, r1) = (
-                (m.offset_um - m.offset_se_um).max(0.0),
-                m.offset_um + m.offset_se_um,
+                (m.offset_um - m.offset_um_se).max(0.0),
+                m.offset_um + m.offset_um_se,
             );
-            let (a0, a1) = (m.angle_deg - m.angle_se_deg, m.angle_deg + m.angle_se_deg);
+            let (a0, a1) = (m.angle_deg - m.angle_deg_se, m.angle_deg + m.angle_deg_se);
             let mut pts: Vec<(f64, f64)> = (0..=40)
                 .map(|j| to_xy(r1, a0 + (a1 - a0) * j as f64 / 40.0))
                 .collect();

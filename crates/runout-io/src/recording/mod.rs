@@ -112,12 +112,14 @@ impl ReadOptions {
     }
 }
 
-/// The recording's format.
+/// The recording's format (serialised in snake_case: `generic_csv`, `{"dynoware": {…}}`, …).
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Format {
     /// A CSV/TSV with a header row.
     GenericCsv,
     /// A Kistler DynoWare text export.
+    #[serde(rename = "dynoware")]
     DynoWare {
         /// The version on line 1 (`Version 2.5.1.2`).
         version: String,

@@ -142,3 +142,34 @@ fn edge_csv_and_path_writer() {
     let bad = read_edge_csv("x_mm,y_mm,z_mm,nx\n1,2,3,4\n", "edge.csv").unwrap_err();
     assert!(bad.to_string().contains("nx, ny, nz"));
 }
+
+/// Issue 21 item 7: every map has a colour bar labelled with its unit — the grind deviation heat
+/// map (δ in µm, −max … +max) and the chip path × height map (h in µm).
+#[test]
+fn heat_maps_have_colour_bars_with_units() {
+    let g = assemble(&grid_text(&rows())).unwrap();
+    let map = DeviationMap::new(&g);
+    let svg = runout_io::grind::plot::deviation_heatmap_svg(&map).unwrap();
+    assert!(
+        svg.contains("δ (µm)"),
+        "no colour-bar label in the deviation map"
+    );
+    // the bar is 100 bands; the map itself is 12 cells (a few split at 0°/360°)
+    let rects = svg.matches("<rect").count();
+    assert!(rects >= 100 + 12, "{rects} rectangles: no colour bar");
+    let d = std::env::temp_dir().join(format!("runout-map-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let f = d.join("chip_map.svg");
+    let chip = runout_io::plot::chip::ChipMap {
+        time_s: vec![0.0, 0.1, 0.2],
+        height_mm: vec![0.5, 1.5],
+        values: vec![vec![1.0, 2.0], vec![3.0, 4.0], vec![5.0, 6.0]],
+    };
+    runout_io::plot::chip::chip_map_plot(&f, &chip, "map").unwrap();
+    let svg = std::fs::read_to_string(&f).unwrap();
+    assert!(
+        svg.contains("h (µm)"),
+        "no colour-bar label in the chip map"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -56,8 +56,8 @@ fn identify_plots_render_svg_and_png() {
             label: "sine fit",
             offset_um: 7.7,
             angle_deg: -35.0,
-            offset_se_um: 0.4,
-            angle_se_deg: 4.0,
+            offset_um_se: 0.4,
+            angle_deg_se: 4.0,
         };
         runout_polar(&pp, &[mark], 4, "runout").unwrap();
         for file in [f, b, pp] {

@@ -33,7 +33,8 @@ pub struct HeightsInput {
 #[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct VectorReport {
     pub offset_um: f64,
-    pub offset_se_um: Option<f64>,
+    #[serde(alias = "offset_se_um")]
+    pub offset_um_se: Option<f64>,
     pub offset_at_zero_um: [f64; 2],
     pub tilt_um_per_mm: [f64; 2],
     pub residual_rms_um: f64,
@@ -41,19 +42,25 @@ pub struct VectorReport {
     pub angle: AngleReport,
 }
 
-/// `runout.displacement.heights/1`.
+/// `runout.displacement.heights/2`.
 #[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct HeightsReport {
-    /// `runout.displacement.heights/1`
-    #[schemars(extend("const" = "runout.displacement.heights/1"))]
+    /// `runout.displacement.heights/2`
+    #[schemars(extend("const" = "runout.displacement.heights/2"))]
     pub schema: String,
+    /// The result first: ρ ± SE at the cutting height (λ ± SE with the angle column), the
+    /// method, the status and its reasons (issue 21).
+    #[serde(default)]
+    pub answer: crate::answer::Answer,
     pub input: HeightsInput,
     pub method: String,
     pub at_mm: f64,
     pub offset_um: f64,
-    pub offset_se_um: Option<f64>,
+    #[serde(alias = "offset_se_um")]
+    pub offset_um_se: Option<f64>,
     pub slope_um_per_mm: f64,
-    pub slope_se_um_per_mm: Option<f64>,
+    #[serde(alias = "slope_se_um_per_mm")]
+    pub slope_um_per_mm_se: Option<f64>,
     pub r_squared: f64,
     pub residual_rms_um: f64,
     pub notes: Vec<String>,
@@ -76,8 +83,14 @@ pub struct HeightsDetail {
     pub vector: Option<VectorHeightFit>,
 }
 
+impl crate::answer::Answered for HeightsReport {
+    fn answer(&self) -> &crate::answer::Answer {
+        &self.answer
+    }
+}
+
 impl Report for HeightsReport {
-    const SCHEMA: &'static str = "runout.displacement.heights/1";
+    const SCHEMA: &'static str = "runout.displacement.heights/2";
 }
 
 /// Regress runout on height; with angles, the offset + tilt vector fit as well.
@@ -125,7 +138,7 @@ pub fn heights(req: &HeightsRequest) -> Result<HeightsReport> {
     let verdict = VerdictReport::new(
         VerdictBasis {
             offset_um: fit.offset_mm * 1e3,
-            offset_se_um: fit.offset_se_mm.map(|s| s * 1e3),
+            offset_um_se: fit.offset_se_mm.map(|s| s * 1e3),
             angle_deg: vector
                 .as_ref()
                 .and_then(|v| v.angle.angle())
@@ -139,8 +152,56 @@ pub fn heights(req: &HeightsRequest) -> Result<HeightsReport> {
         None,
     )?
     .with_axis(axis);
+    let regression = crate::answer::Quantity::cross_check(
+        "runout offset ρ",
+        "µm",
+        fit.offset_mm * 1e3,
+        fit.offset_se_mm.map(|s| s * 1e3),
+    );
+    let todo = "measure at more heights, or repeat the readings at each height";
+    let answer = match &vector {
+        Some(v) => {
+            let angle = AngleReport::from(&v.angle);
+            super::runout_answer(
+                "offset + tilt vector fit e(z) = e₀ + z·τ of the runout vectors, at the cutting \
+                 height (docs/methods.md §1.6)",
+                v.offset_mm * 1e3,
+                v.offset_se_mm.map(|s| s * 1e3),
+                Some(&angle),
+                f64::INFINITY,
+                None,
+                todo,
+                vec![crate::answer::CrossCheck {
+                    estimate: format!(
+                        "straight line through the runout magnitudes ({})",
+                        crate::words::plain(&fit.method)
+                    ),
+                    values: vec![regression],
+                    why_it_may_differ: "the magnitudes |e(z)| are not linear in z when the \
+                                        offset and the tilt point in different directions; \
+                                        the vector fit uses the angles"
+                        .into(),
+                }],
+            )
+        }
+        None => super::runout_answer(
+            &format!(
+                "straight line through the runout magnitudes ({}), extrapolated to the cutting \
+                 height (docs/methods.md §1.3)",
+                crate::words::plain(&fit.method)
+            ),
+            fit.offset_mm * 1e3,
+            fit.offset_se_mm.map(|s| s * 1e3),
+            None,
+            f64::INFINITY,
+            None,
+            todo,
+            Vec::new(),
+        ),
+    };
     Ok(HeightsReport {
         schema: HeightsReport::SCHEMA.into(),
+        answer,
         input: HeightsInput {
             file,
             points: fit.points,
@@ -148,15 +209,15 @@ pub fn heights(req: &HeightsRequest) -> Result<HeightsReport> {
         method: name_of(&fit.method),
         at_mm: fit.height_mm,
         offset_um: fit.offset_mm * 1e3,
-        offset_se_um: fit.offset_se_mm.map(|s| s * 1e3),
+        offset_um_se: fit.offset_se_mm.map(|s| s * 1e3),
         slope_um_per_mm: fit.slope * 1e3,
-        slope_se_um_per_mm: fit.slope_se.map(|s| s * 1e3),
+        slope_um_per_mm_se: fit.slope_se.map(|s| s * 1e3),
         r_squared: fit.r_squared,
         residual_rms_um: fit.residual_rms_mm * 1e3,
         notes: fit.notes.clone(),
         vector: vector.as_ref().map(|v| VectorReport {
             offset_um: v.offset_mm * 1e3,
-            offset_se_um: v.offset_se_mm.map(|s| s * 1e3),
+            offset_um_se: v.offset_se_mm.map(|s| s * 1e3),
             offset_at_zero_um: [v.offset_at_zero_mm[0] * 1e3, v.offset_at_zero_mm[1] * 1e3],
             tilt_um_per_mm: [v.tilt[0] * 1e3, v.tilt[1] * 1e3],
             residual_rms_um: v.residual_rms_mm * 1e3,

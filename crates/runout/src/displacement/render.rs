@@ -34,7 +34,7 @@ pub fn angle_text(a: &AngleEstimate) -> String {
 
 /// Text of the consequences.
 pub fn consequences_text(c: &Consequences) -> String {
-    let mut s = String::from("predicted (methods.md §1.7):\n");
+    let mut s = String::from("predicted (docs/methods.md §1.7):\n");
     for (i, r) in c.tooth_radii_mm.iter().enumerate() {
         s += &format!("  tooth {i}: radius {r:.6} mm");
         if let Some(h) = &c.chip_load_mm {
@@ -56,6 +56,10 @@ fn notes_text(notes: &[String]) -> String {
 
 /// `displacement teeth` text.
 pub fn teeth_text(r: &TeethReport) -> String {
+    r.answer.text() + &teeth_body(r)
+}
+
+fn teeth_body(r: &TeethReport) -> String {
     let Some(fit) = &r.detail.fit else {
         return String::new();
     };
@@ -134,6 +138,10 @@ pub fn teeth_plot(path: &Path, r: &TeethReport) -> Result<()> {
 
 /// `displacement heights` text.
 pub fn heights_text(r: &HeightsReport) -> String {
+    r.answer.text() + &heights_body(r)
+}
+
+fn heights_body(r: &HeightsReport) -> String {
     let Some(fit) = &r.detail.fit else {
         return String::new();
     };
@@ -164,7 +172,7 @@ pub fn heights_text(r: &HeightsReport) -> String {
     );
     if let Some(v) = &r.detail.vector {
         s += &format!(
-            "vector fit (offset + tilt, methods.md §1.6): runout {:.3} µm, {}; tilt ({:.4}, {:.4}) µm/mm\n",
+            "vector fit (offset + tilt, docs/methods.md §1.6): runout {:.3} µm, {}; tilt ({:.4}, {:.4}) µm/mm\n",
             v.offset_mm * 1e3,
             angle_text(&v.angle),
             v.tilt[0] * 1e3,
@@ -205,6 +213,10 @@ pub fn heights_plot(path: &Path, r: &HeightsReport) -> Result<()> {
 
 /// `displacement signal` text.
 pub fn signal_text(r: &SignalReport) -> String {
+    r.answer.text() + &signal_body(r)
+}
+
+fn signal_body(r: &SignalReport) -> String {
     let Some(fit) = &r.detail.fit else {
         return String::new();
     };

@@ -92,7 +92,8 @@ pub struct PerRevolution {
 #[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct SignalTeeth {
     pub offset_um: f64,
-    pub offset_se_um: Option<f64>,
+    #[serde(alias = "offset_se_um")]
+    pub offset_um_se: Option<f64>,
     pub positions_um: Vec<f64>,
     pub notes: Vec<String>,
     #[serde(flatten)]
@@ -101,12 +102,15 @@ pub struct SignalTeeth {
     pub consequences: Option<ConsequencesReport>,
 }
 
-/// `runout.displacement.signal/1`.
+/// `runout.displacement.signal/2`.
 #[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct SignalReport {
-    /// `runout.displacement.signal/1`
-    #[schemars(extend("const" = "runout.displacement.signal/1"))]
+    /// `runout.displacement.signal/2`
+    #[schemars(extend("const" = "runout.displacement.signal/2"))]
     pub schema: String,
+    /// The result first: ρ ± SE, λ ± SE, the method, the status and its reasons (issue 21).
+    #[serde(default)]
+    pub answer: crate::answer::Answer,
     pub input: SignalInputReport,
     pub reference: String,
     pub rpm: f64,
@@ -114,7 +118,8 @@ pub struct SignalReport {
     pub revolutions: usize,
     pub samples_used: usize,
     pub offset_um: f64,
-    pub offset_se_um: f64,
+    #[serde(alias = "offset_se_um")]
+    pub offset_um_se: f64,
     pub vector_um: [f64; 2],
     pub channel_agreement_chi2: Option<f64>,
     pub channels: Vec<ChannelReport>,
@@ -144,8 +149,14 @@ pub struct SignalDetail {
     pub plot: Option<TeethPlot>,
 }
 
+impl crate::answer::Answered for SignalReport {
+    fn answer(&self) -> &crate::answer::Answer {
+        &self.answer
+    }
+}
+
 impl Report for SignalReport {
-    const SCHEMA: &'static str = "runout.displacement.signal/1";
+    const SCHEMA: &'static str = "runout.displacement.signal/2";
 }
 
 fn sensor_angles(given: &Option<Vec<f64>>, n: usize) -> Result<Vec<f64>> {
@@ -246,7 +257,7 @@ pub fn signal(req: &SignalRequest) -> Result<SignalReport> {
     let verdict = VerdictReport::new(
         VerdictBasis {
             offset_um: fit.offset_mm * 1e3,
-            offset_se_um: Some(fit.offset_se_mm * 1e3),
+            offset_um_se: Some(fit.offset_se_mm * 1e3),
             angle_deg: fit.angle.angle().map(f64::to_degrees),
             teeth: req.cutter.as_ref().map(Cutter::teeth),
             diameter_mm: req.cutter.as_ref().map(Cutter::diameter),
@@ -256,8 +267,54 @@ pub fn signal(req: &SignalRequest) -> Result<SignalReport> {
         },
         None,
     )?;
+    let angle = AngleReport::from(&fit.angle);
+    let mut checks: Vec<crate::answer::CrossCheck> = revs
+        .iter()
+        .zip(names)
+        .map(|(r, (name, _))| crate::answer::CrossCheck {
+            estimate: format!("TIR/2 per revolution of {name} (seed eq. 5), mean"),
+            values: vec![crate::answer::Quantity::cross_check(
+                "runout offset ρ",
+                "µm",
+                r.mean_mm * 1e3,
+                r.sd_mm.map(|s| s * 1e3),
+            )],
+            why_it_may_differ: "half the peak-to-peak displacement includes the out-of-round \
+                                of the surface, the tooth profile and the noise; the first \
+                                harmonic is the runout alone"
+                .into(),
+        })
+        .collect();
+    if let Some((tf, _)) = &teeth {
+        checks.push(crate::answer::CrossCheck {
+            estimate: "fit to the per-tooth extrema".into(),
+            values: vec![crate::answer::Quantity::cross_check(
+                "runout offset ρ",
+                "µm",
+                tf.offset_mm * 1e3,
+                tf.offset_se_mm.map(|s| s * 1e3),
+            )],
+            why_it_may_differ: "uses one extremum per tooth instead of the whole revolution, \
+                                so it is noisier and sees the edge profile"
+                .into(),
+        });
+    }
+    let answer = super::runout_answer(
+        "first harmonic of the displacement against the spindle angle, least squares over the \
+         whole section (docs/methods.md §1.5)",
+        fit.offset_mm * 1e3,
+        Some(fit.offset_se_mm * 1e3),
+        Some(&angle),
+        req.cutter
+            .as_ref()
+            .map_or(f64::INFINITY, |c| c.diameter() / 2.0),
+        req.fz_mm,
+        "record more revolutions, or check the sensor's gain and mounting",
+        checks,
+    );
     Ok(SignalReport {
         schema: SignalReport::SCHEMA.into(),
+        answer,
         input: SignalInputReport {
             file: file.clone(),
             channels: names.iter().map(|c| c.0.clone()).collect(),
@@ -268,7 +325,7 @@ pub fn signal(req: &SignalRequest) -> Result<SignalReport> {
         revolutions: fit.revolutions,
         samples_used: fit.samples_used,
         offset_um: fit.offset_mm * 1e3,
-        offset_se_um: fit.offset_se_mm * 1e3,
+        offset_um_se: fit.offset_se_mm * 1e3,
         vector_um: [fit.vector_mm[0] * 1e3, fit.vector_mm[1] * 1e3],
         channel_agreement_chi2: fit.channel_agreement_chi2,
         channels: fit
@@ -284,7 +341,7 @@ pub fn signal(req: &SignalRequest) -> Result<SignalReport> {
             })
             .collect(),
         notes: fit.notes.clone(),
-        angle: AngleReport::from(&fit.angle),
+        angle,
         section: SectionReport {
             from_s: table.start_s,
             to_s: end_s,
@@ -302,7 +359,7 @@ pub fn signal(req: &SignalRequest) -> Result<SignalReport> {
             .collect(),
         teeth: teeth.as_ref().map(|(tf, cons)| SignalTeeth {
             offset_um: tf.offset_mm * 1e3,
-            offset_se_um: tf.offset_se_mm.map(|s| s * 1e3),
+            offset_um_se: tf.offset_se_mm.map(|s| s * 1e3),
             positions_um: tf.positions_mm.iter().map(|p| p * 1e3).collect(),
             notes: tf.notes.clone(),
             angle: AngleReport::from(&tf.angle),

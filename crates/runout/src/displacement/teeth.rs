@@ -1,6 +1,7 @@
 //! `displacement teeth`: per-tooth readings → (ρ, λ), methods.md §1.5.
 
 use super::{name_of, AngleReport, BeamReport, ConsequencesReport, Sensor};
+use crate::answer::{Answer, Answered, CrossCheck, Quantity};
 use crate::job::{Report, Source};
 use crate::verdict::{VerdictBasis, VerdictReport};
 use anyhow::{Context, Result};
@@ -38,21 +39,26 @@ pub struct TeethInput {
     pub height_mm: f64,
     pub beam: BeamReport,
     pub known_offset_um: Option<f64>,
-    pub known_offset_se_um: Option<f64>,
+    #[serde(alias = "known_offset_se_um")]
+    pub known_offset_um_se: Option<f64>,
     pub noise_um: Option<f64>,
     pub phase_deg: Option<f64>,
 }
 
-/// `runout.displacement.teeth/1`.
+/// `runout.displacement.teeth/2`.
 #[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct TeethReport {
-    /// `runout.displacement.teeth/1`
-    #[schemars(extend("const" = "runout.displacement.teeth/1"))]
+    /// `runout.displacement.teeth/2`
+    #[schemars(extend("const" = "runout.displacement.teeth/2"))]
     pub schema: String,
+    /// The result first: ρ ± SE, λ ± SE, the method, the status and its reasons (issue 21).
+    #[serde(default)]
+    pub answer: Answer,
     pub input: TeethInput,
     pub method: String,
     pub offset_um: f64,
-    pub offset_se_um: Option<f64>,
+    #[serde(alias = "offset_se_um")]
+    pub offset_um_se: Option<f64>,
     pub positions_um: Vec<f64>,
     pub radius_differences_um: Vec<f64>,
     pub residual_rms_um: f64,
@@ -81,8 +87,14 @@ pub struct TeethDetail {
     pub consequences: Option<Consequences>,
 }
 
+impl Answered for TeethReport {
+    fn answer(&self) -> &Answer {
+        &self.answer
+    }
+}
+
 impl Report for TeethReport {
-    const SCHEMA: &'static str = "runout.displacement.teeth/1";
+    const SCHEMA: &'static str = "runout.displacement.teeth/2";
 }
 
 /// Fit the runout to per-tooth readings.
@@ -106,12 +118,41 @@ pub fn teeth(req: &TeethRequest) -> Result<TeethReport> {
         None => None,
     };
     let um = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<_>>();
+    let angle = AngleReport::from(&fit.angle);
+    let spread = {
+        let p = &fit.positions_mm;
+        let max = p.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let min = p.iter().copied().fold(f64::INFINITY, f64::min);
+        (max - min) / 2.0 * 1e3
+    };
+    let answer = super::runout_answer(
+        &format!(
+            "{} fit of the runout to the per-tooth readings (docs/methods.md §1.5)",
+            crate::words::plain(&fit.method)
+        ),
+        fit.offset_mm * 1e3,
+        fit.offset_se_mm.map(|x| x * 1e3),
+        Some(&angle),
+        cutter.diameter() / 2.0,
+        req.fz_mm,
+        "repeat the readings (several sweeps give the noise) or pass --noise-um, the noise of one \
+         reading",
+        vec![CrossCheck {
+            estimate: "half the spread of the readings, (max P − min P)/2".into(),
+            values: vec![Quantity::cross_check("runout offset ρ", "µm", spread, None)],
+            why_it_may_differ: format!(
+                "equals ρ only when two teeth lie along the runout direction; with {k} teeth it is \
+                 smaller otherwise, and it takes the reading noise as runout"
+            ),
+        }],
+    );
     let sensor = Sensor {
         sign: req.sign,
         beam: opts.beam,
     };
     Ok(TeethReport {
         schema: TeethReport::SCHEMA.into(),
+        answer,
         input: TeethInput {
             file: name.to_string(),
             tooth_numbering: if table.from_seed_edges {
@@ -126,13 +167,13 @@ pub fn teeth(req: &TeethRequest) -> Result<TeethReport> {
             height_mm: opts.height_mm,
             beam: BeamReport::from(&sensor),
             known_offset_um: opts.known_offset_mm.map(|x| x * 1e3),
-            known_offset_se_um: opts.known_offset_se_mm.map(|x| x * 1e3),
+            known_offset_um_se: opts.known_offset_se_mm.map(|x| x * 1e3),
             noise_um: opts.noise_mm.map(|x| x * 1e3),
             phase_deg: opts.phase_hint_rad.map(f64::to_degrees),
         },
         method: name_of(&fit.method),
         offset_um: fit.offset_mm * 1e3,
-        offset_se_um: fit.offset_se_mm.map(|x| x * 1e3),
+        offset_um_se: fit.offset_se_mm.map(|x| x * 1e3),
         positions_um: um(&fit.positions_mm),
         radius_differences_um: um(&fit.radius_differences_mm),
         residual_rms_um: fit.residual_rms_mm * 1e3,
@@ -146,7 +187,7 @@ pub fn teeth(req: &TeethRequest) -> Result<TeethReport> {
         verdict: Some(VerdictReport::new(
             VerdictBasis {
                 offset_um: fit.offset_mm * 1e3,
-                offset_se_um: fit.offset_se_mm.map(|x| x * 1e3),
+                offset_um_se: fit.offset_se_mm.map(|x| x * 1e3),
                 angle_deg: fit.angle.angle().map(f64::to_degrees),
                 teeth: Some(k),
                 diameter_mm: Some(cutter.diameter()),
@@ -156,7 +197,7 @@ pub fn teeth(req: &TeethRequest) -> Result<TeethReport> {
             },
             None,
         )?),
-        angle: AngleReport::from(&fit.angle),
+        angle,
         detail: TeethDetail {
             fit: Some(fit),
             options: Some(opts.clone()),

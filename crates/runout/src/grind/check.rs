@@ -72,12 +72,18 @@ pub struct SchemeCheck {
     pub profile_error_after_um: f64,
 }
 
-/// `runout.grind.check/1`.
+/// `runout.grind.check/2`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct CheckReport {
-    /// `runout.grind.check/1`
-    #[schemars(extend("const" = "runout.grind.check/1"))]
+    /// `runout.grind.check/2`
+    #[schemars(extend("const" = "runout.grind.check/2"))]
     pub schema: String,
+    /// The result first: the edge's radius error after the first-harmonic compensation against
+    /// the uncompensated one, the status and its reasons (issue 21). A simulation: the status
+    /// says whether this probing plan identifies the bar axis well enough for the compensation
+    /// to help (`not identified` when the compensated edge is no better than the uncompensated
+    /// one); how large an error is acceptable is the user's tolerance, a verdict, not a status.
+    pub answer: crate::answer::Answer,
     pub inputs: CheckInputs,
     pub definitions: String,
     pub uncompensated: Uncompensated,
@@ -85,8 +91,14 @@ pub struct CheckReport {
     pub first_harmonic: SchemeCheck,
 }
 
+impl crate::answer::Answered for CheckReport {
+    fn answer(&self) -> &crate::answer::Answer {
+        &self.answer
+    }
+}
+
 impl Report for CheckReport {
-    const SCHEMA: &'static str = "runout.grind.check/1";
+    const SCHEMA: &'static str = "runout.grind.check/2";
 }
 
 /// Mean over draws of the grind check for each scheme.
@@ -164,8 +176,59 @@ pub fn check(req: &CheckRequest) -> Result<CheckReport> {
         radius_error_after_um: um(c.radius_error_after),
         profile_error_after_um: um(c.profile_after),
     };
+    let answer = {
+        use crate::answer::{Answer, CrossCheck, Quantity};
+        let (before, after) = (um(har.radius_error_before), um(har.radius_error_after));
+        let ok = after < before;
+        Answer {
+            status: Answer::status_of(ok, true).into(),
+            method: format!(
+                "simulation: a bar clamped with the given offset and tilt, probed at {} layers × \
+                 {} angles with noise σ = {:.2} µm ({} draws), compensated by the first \
+                 harmonic per layer (docs/methods.md §5.5)",
+                req.layers,
+                req.angles,
+                um(sigma),
+                req.draws
+            ),
+            runout: None,
+            results: vec![
+                Quantity::identified("radius error after compensation", "µm", after, None),
+                Quantity::identified(
+                    "profile error after compensation",
+                    "µm",
+                    um(har.profile_after),
+                    None,
+                ),
+                Quantity::identified("radius error without compensation", "µm", before, None),
+            ],
+            reasons: if ok {
+                Vec::new()
+            } else {
+                vec![format!(
+                    "the compensated edge ({after:.2} µm) is no better than the uncompensated one \
+                     ({before:.2} µm): this probing plan does not identify the bar axis (noise \
+                     too large for the clamping error); probe more layers and angles"
+                )]
+            },
+            warnings: Vec::new(),
+            cross_checks: vec![CrossCheck {
+                estimate: "bilinear interpolation of the deviation map".into(),
+                values: vec![Quantity::cross_check(
+                    "radius error after compensation",
+                    "µm",
+                    um(bil.radius_error_after),
+                    None,
+                )],
+                why_it_may_differ: "interpolates the measured deviations (noise and form \
+                                    included) instead of fitting the rigid axis"
+                    .into(),
+            }],
+        }
+    };
     Ok(CheckReport {
         schema: CheckReport::SCHEMA.into(),
+        answer,
         inputs: CheckInputs {
             bar_diameter_mm: d,
             offset_um: off,
@@ -178,7 +241,7 @@ pub fn check(req: &CheckRequest) -> Result<CheckReport> {
             seed: req.seed,
             edge: spec.name(),
             edge_points: edge.points.len(),
-            outside_probed_range: format!("{:?}", req.range),
+            outside_probed_range: crate::words::snake(&req.range),
         },
         definitions: "interpolation error ε − e(u)·n against the true axis; radius error max |r − r_nominal| and profile error max − min of the finished edge about the real axis (ball: about the real ball centre); averages over draws".into(),
         uncompensated: Uncompensated {

@@ -109,9 +109,11 @@ pub struct AxisReport {
     pub offset_um: f64,
     pub offset_angle_bar_deg: f64,
     pub runout_angle_deg: f64,
-    pub offset_se_um: Option<[f64; 2]>,
+    #[serde(alias = "offset_se_um")]
+    pub offset_um_se: Option<[f64; 2]>,
     pub tilt_um_per_mm: [f64; 2],
-    pub tilt_se_um_per_mm: Option<[f64; 2]>,
+    #[serde(alias = "tilt_se_um_per_mm")]
+    pub tilt_um_per_mm_se: Option<[f64; 2]>,
     pub layer_residual_rms_um: f64,
     pub uncertainty: String,
 }
@@ -142,12 +144,16 @@ pub struct NcReport {
     pub changed_lines: usize,
 }
 
-/// `runout.grind.compensate/1`.
+/// `runout.grind.compensate/2`.
 #[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct CompensateReport {
-    /// `runout.grind.compensate/1`
-    #[schemars(extend("const" = "runout.grind.compensate/1"))]
+    /// `runout.grind.compensate/2`
+    #[schemars(extend("const" = "runout.grind.compensate/2"))]
     pub schema: String,
+    /// The result first: the bar axis offset ρ ± SE at the tip, its tilt, the predicted
+    /// remaining error, the status and its reasons (issue 21).
+    #[serde(default)]
+    pub answer: crate::answer::Answer,
     pub inputs: InputsReport,
     pub frame: String,
     pub grid: GridReport,
@@ -171,8 +177,107 @@ pub struct CompensateDetail {
     pub nc_text: Option<String>,
 }
 
+/// The answer of `grind compensate` (issue 21 item 1): the clamped bar's axis at the tip
+/// (ρ ± SE, λ) and its tilt, which the compensation removes. `identified` when the axis's SE is
+/// at most 25 % of ρ or at most 1 µm (a compensation known to 1 µm is as good as a grinder
+/// holds); `partly identified` with two probe layers (the axis line fits them exactly: no SE);
+/// `not identified` when the SE is larger. Edge points outside the probed range are a warning.
+#[allow(clippy::too_many_arguments)]
+fn compensate_answer(
+    rho: f64,
+    lambda: f64,
+    offset: [f64; 2],
+    offset_se: Option<[f64; 2]>,
+    tilt: [f64; 2],
+    tilt_se: Option<[f64; 2]>,
+    layers: usize,
+    outside: usize,
+    range: String,
+    remaining: (f64, f64),
+    before: (f64, f64),
+) -> crate::answer::Answer {
+    use crate::answer::{Answer, CrossCheck, Quantity, RunoutAnswer, IDENTIFIED, NOT_IDENTIFIED};
+    // SE of |e| and of |τ| by the delta method: √((x·s_x)² + (y·s_y)²)/|e|
+    let mag_se = |v: [f64; 2], se: [f64; 2]| {
+        let m = v[0].hypot(v[1]);
+        if m > 0.0 {
+            (v[0] * se[0]).hypot(v[1] * se[1]) / m
+        } else {
+            se[0].hypot(se[1])
+        }
+    };
+    let rho_se = offset_se.map(|s| mag_se(offset, s));
+    let tilt_mag = tilt[0].hypot(tilt[1]);
+    let tilt_mag_se = tilt_se.map(|s| mag_se(tilt, s));
+    let mut reasons = Vec::new();
+    let mut warnings = Vec::new();
+    let (rho_ok, all_ok) = match rho_se {
+        None => {
+            reasons.push(format!(
+                "{layers} probe layers: the axis line fits them exactly, so its uncertainty is \
+                 unknown; probe at 3 or more heights"
+            ));
+            (true, false)
+        }
+        Some(se) if se > crate::answer::MAX_RELATIVE_SE * rho && se > 1.0 => {
+            reasons.push(format!(
+                "bar axis offset ρ = {rho:.2} ± {se:.2} µm: the standard error is more than 25 % \
+                 of ρ and more than 1 µm, so the compensation would add as much error as it \
+                 removes; probe more angles per layer or more layers, or check the probe's noise"
+            ));
+            (false, false)
+        }
+        Some(_) => (true, true),
+    };
+    if outside > 0 {
+        warnings.push(format!(
+            "{outside} edge points lie outside the probed heights ({range} there): probe over \
+             the whole edge length"
+        ));
+    }
+    let q = |name: &str, unit: &str, v: f64, se: Option<f64>| {
+        if rho_ok {
+            Quantity::identified(name, unit, v, se)
+        } else {
+            Quantity::not_identified(name, unit)
+        }
+    };
+    Answer {
+        status: Answer::status_of(rho_ok, all_ok).into(),
+        method: "first harmonic of the deviation per probe layer, bar axis offset + tilt by a \
+                 straight line through the layers (docs/methods.md §5.2, §5.3)"
+            .into(),
+        runout: Some(RunoutAnswer {
+            offset_um: rho_ok.then_some(rho),
+            offset_um_se: if rho_ok { rho_se } else { None },
+            angle_deg: rho_ok.then_some(lambda),
+            angle_deg_se: None,
+            angle: if rho_ok { IDENTIFIED } else { NOT_IDENTIFIED }.into(),
+        }),
+        results: vec![
+            q("tilt of the bar axis", "µm/mm", tilt_mag, tilt_mag_se),
+            q("predicted remaining error, max", "µm", remaining.1, None),
+        ],
+        reasons,
+        warnings,
+        cross_checks: vec![CrossCheck {
+            estimate: "the deviation before compensation, max".into(),
+            values: vec![Quantity::cross_check("deviation", "µm", before.1, None)],
+            why_it_may_differ: "what the clamping error would leave on the edge without \
+                                compensation: the runout plus the tilt along the edge"
+                .into(),
+        }],
+    }
+}
+
+impl crate::answer::Answered for CompensateReport {
+    fn answer(&self) -> &crate::answer::Answer {
+        &self.answer
+    }
+}
+
 impl Report for CompensateReport {
-    const SCHEMA: &'static str = "runout.grind.compensate/1";
+    const SCHEMA: &'static str = "runout.grind.compensate/2";
 }
 
 fn generatrix(g: &GeneratrixFrom) -> Result<Generatrix> {
@@ -362,13 +467,27 @@ fn report(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
             (l.min(*x), h.max(*x))
         });
+    let answer = compensate_answer(
+        o_mag,
+        o_lambda,
+        um2(ax.offset),
+        ax.offset_se.map(um2),
+        um2(ax.tilt),
+        ax.tilt_se.map(um2),
+        grid.layer_count(),
+        comp.outside_count(),
+        crate::words::plain(&comp.range),
+        (ra * 1e3, ma * 1e3),
+        (rb * 1e3, mb * 1e3),
+    );
     CompensateReport {
         schema: CompensateReport::SCHEMA.into(),
+        answer,
         inputs: InputsReport {
             probe: req.probe.name().to_string(),
             edge: req.edge.name(),
-            scheme: format!("{:?}", comp.scheme),
-            outside_probed_range: format!("{:?}", comp.range),
+            scheme: crate::words::snake(&comp.scheme),
+            outside_probed_range: crate::words::snake(&comp.range),
             probe_angle_sense: match req.angle_sense {
                 AngleSense::Ccw => "ccw",
                 AngleSense::Cw => "cw",
@@ -376,8 +495,8 @@ fn report(
             .into(),
             probe_tip_radius_mm: opts.tip_radius_mm,
             miss_limit_um: opts.miss_limit_mm * 1e3,
-            duplicates: format!("{:?}", opts.duplicates),
-            missing: format!("{:?}", opts.missing),
+            duplicates: crate::words::snake(&opts.duplicates),
+            missing: crate::words::snake(&opts.missing),
         },
         frame: "bar frame: u from the tool tip along the work-head axis; x, y right-handed, α counter-clockwise about +u (= −spindle-frame angle, conventions.md)".into(),
         grid: GridReport {
@@ -405,9 +524,9 @@ fn report(
             offset_um: o_mag,
             offset_angle_bar_deg: o_ang,
             runout_angle_deg: o_lambda,
-            offset_se_um: ax.offset_se.map(um2),
+            offset_um_se: ax.offset_se.map(um2),
             tilt_um_per_mm: um2(ax.tilt),
-            tilt_se_um_per_mm: ax.tilt_se.map(um2),
+            tilt_um_per_mm_se: ax.tilt_se.map(um2),
             layer_residual_rms_um: ax.residual_rms * 1e3,
             uncertainty: "standard errors from the residual scatter of the per-layer first harmonics about the line (null with 2 layers)".into(),
         },

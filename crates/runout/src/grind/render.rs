@@ -8,6 +8,10 @@ use std::path::Path;
 
 /// `grind compensate` text.
 pub fn compensate_text(r: &CompensateReport) -> String {
+    r.answer.text() + &compensate_body(r)
+}
+
+fn compensate_body(r: &CompensateReport) -> String {
     let (Some(map), Some(comp)) = (&r.detail.map, &r.detail.compensation) else {
         return String::new();
     };
@@ -113,6 +117,10 @@ pub fn compensate_plots(dir: &Path, fmt: &str, r: &CompensateReport) -> Result<(
 
 /// `grind check` text.
 pub fn check_text(r: &CheckReport) -> String {
+    r.answer.text() + &check_body(r)
+}
+
+fn check_body(r: &CheckReport) -> String {
     let i = &r.inputs;
     let (off, tilt) = (i.offset_um, i.tilt_um_per_mm);
     let [u0, u1] = i.u_range_mm;

@@ -201,8 +201,8 @@ impl ToSection for RecordingsReport {
                 label: l,
                 offset_um: *o,
                 angle_deg: *a,
-                offset_se_um: *os,
-                angle_se_deg: *as_,
+                offset_um_se: *os,
+                angle_deg_se: *as_,
             })
             .collect();
         if !rm.is_empty() {
@@ -237,7 +237,7 @@ impl ToSection for RecordingsReport {
                 s.plots.push(Plot {
                     id: format!("tooth_peaks_{n}"),
                     caption: format!(
-                        "{}: per-tooth peaks ±1 SE with the fitted sine (methods.md §4.2).",
+                        "{}: per-tooth peaks ±1 SE with the fitted sine (docs/methods.md §4.2).",
                         file_label(&rec.file)
                     ),
                     svg: tooth_peak_bars_svg(
@@ -269,7 +269,7 @@ impl ToSection for RecordingsReport {
         s.warnings
             .extend(self.radius_difference_warnings.iter().cloned());
         s.method = vec![
-            "Spindle speed measured, steady cut detected, synchronous average over whole revolutions; per-tooth peaks with the seed-003 sine fit F_i = C + A·sin(φ + 2πi/K) (methods.md §4.2); mean-force calibration of the cutting coefficients over ≥ 2 feeds (methods.md §4.4); full-signal fit of all recordings jointly through the measuring chain (methods.md §4.7), standard errors from the fit's covariance.".into(),
+            "Spindle speed measured, steady cut detected, synchronous average over whole revolutions; per-tooth peaks with the seed-003 sine fit F_i = C + A·sin(φ + 2πi/K) (docs/methods.md §4.2); mean-force calibration of the cutting coefficients over ≥ 2 feeds (docs/methods.md §4.4); full-signal fit of all recordings jointly through the measuring chain (docs/methods.md §4.7), standard errors from the fit's covariance.".into(),
         ];
         super::sections::verdict_parts(&mut s, &self.verdict);
         Ok(s)

@@ -274,7 +274,7 @@ pub(crate) fn compare_row(v: &VerdictReport) -> Vec<Cell> {
     let b = &v.basis;
     vec![
         Cell::num("/verdict/basis/offset_um", b.offset_um, 2),
-        Cell::opt("/verdict/basis/offset_se_um", b.offset_se_um, 2),
+        Cell::opt("/verdict/basis/offset_um_se", b.offset_um_se, 2),
         Cell::opt("/verdict/basis/angle_deg", b.angle_deg, 1),
         Cell::num("/verdict/tir_um", v.tir_um, 2),
         Cell::num("/verdict/tolerance_tir_um", v.tolerance_tir_um, 1),
@@ -324,17 +324,27 @@ pub fn sections_from_json(
         use crate::{chip, displacement as d, grind, shank};
         let tol = tolerance_tir_um;
         let s = match schema.as_str() {
-            "runout.displacement.teeth/1" => judged(typed::<d::TeethReport>(name, v)?, tol, name)?,
-            "runout.displacement.heights/1" => {
+            // the previous versions differ in the SE keys' spelling (read by aliases) and have
+            // no `answer` (read as empty)
+            "runout.displacement.teeth/2" | "runout.displacement.teeth/1" => {
+                judged(typed::<d::TeethReport>(name, v)?, tol, name)?
+            }
+            "runout.displacement.heights/2" | "runout.displacement.heights/1" => {
                 judged(typed::<d::HeightsReport>(name, v)?, tol, name)?
             }
-            "runout.displacement.signal/1" => {
+            "runout.displacement.signal/2" | "runout.displacement.signal/1" => {
                 judged(typed::<d::SignalReport>(name, v)?, tol, name)?
             }
-            "runout.shank.force/1" => judged(typed::<shank::ForceReport>(name, v)?, tol, name)?,
-            "runout.grind.compensate/1" => typed::<grind::CompensateReport>(name, v)?.section()?,
+            "runout.shank.force/2" | "runout.shank.force/1" => {
+                judged(typed::<shank::ForceReport>(name, v)?, tol, name)?
+            }
+            "runout.grind.compensate/2" | "runout.grind.compensate/1" => {
+                typed::<grind::CompensateReport>(name, v)?.section()?
+            }
             "runout.chip.compare/1" => typed::<chip::CompareReport>(name, v)?.section()?,
-            "runout.identify.recording/2" => sections::saved_identify(&v, name, tol)?,
+            "runout.identify.recording/3" | "runout.identify.recording/2" => {
+                sections::saved_identify(&v, name, tol)?
+            }
             other => bail!(
                 "{name}: schema `{other}` has no HTML page (expected one of: {})",
                 SCHEMAS.join(", ")
@@ -347,11 +357,11 @@ pub fn sections_from_json(
 
 /// The schemas `runout report` renders.
 pub const SCHEMAS: &[&str] = &[
-    "runout.identify.recording/2",
-    "runout.displacement.teeth/1",
-    "runout.displacement.heights/1",
-    "runout.displacement.signal/1",
-    "runout.shank.force/1",
-    "runout.grind.compensate/1",
+    "runout.identify.recording/3",
+    "runout.displacement.teeth/2",
+    "runout.displacement.heights/2",
+    "runout.displacement.signal/2",
+    "runout.shank.force/2",
+    "runout.grind.compensate/2",
     "runout.chip.compare/1",
 ];

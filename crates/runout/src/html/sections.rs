@@ -52,6 +52,71 @@ pub(super) fn row(
     ]
 }
 
+/// The answer first (issue 21 item 1): a table with the status, the runout and the other
+/// results (each ± SE, `not identified` without a value), the reasons and warnings at the head
+/// of the section's warnings.
+fn answer_parts(s: &mut Section, a: &crate::answer::Answer) {
+    if a.status.is_empty() {
+        return; // a saved report of an earlier version: no answer
+    }
+    let mut rows = vec![vec![
+        Cell::text("status"),
+        Cell::text(&a.status),
+        Cell::text(""),
+    ]];
+    let mut q = |name: &str, key: &str, v: Option<f64>, se_key: &str, se: Option<f64>, d| {
+        rows.push(match v {
+            Some(v) => row(name, key, v, Some((se_key, se)), d),
+            None => vec![
+                Cell::text(name),
+                Cell::text("not identified"),
+                Cell::text(""),
+            ],
+        });
+    };
+    if let Some(r) = &a.runout {
+        q(
+            "runout ρ (µm)",
+            "/answer/runout/offset_um",
+            r.offset_um,
+            "/answer/runout/offset_um_se",
+            r.offset_um_se,
+            3,
+        );
+        if r.angle_deg.is_some() {
+            q(
+                "angle λ (deg)",
+                "/answer/runout/angle_deg",
+                r.angle_deg,
+                "/answer/runout/angle_deg_se",
+                r.angle_deg_se,
+                1,
+            );
+        }
+    }
+    for (i, x) in a.results.iter().enumerate() {
+        q(
+            &format!("{} ({})", x.name, x.unit),
+            &format!("/answer/results/{i}/value"),
+            x.value,
+            &format!("/answer/results/{i}/value_se"),
+            x.value_se,
+            4,
+        );
+    }
+    s.tables.insert(
+        0,
+        table(
+            &format!("The answer: {}", a.method),
+            &["quantity", "value", "SE"],
+            rows,
+        ),
+    );
+    let mut w: Vec<String> = a.reasons.iter().chain(&a.warnings).cloned().collect();
+    w.append(&mut s.warnings);
+    s.warnings = w;
+}
+
 fn angle_rows(a: &AngleReport, prefix: &str) -> Vec<Vec<Cell>> {
     let k = |f: &str| format!("{prefix}/{f}");
     match a.angle_deg {
@@ -59,7 +124,7 @@ fn angle_rows(a: &AngleReport, prefix: &str) -> Vec<Vec<Cell>> {
             "angle λ (deg from tooth 0, direction of rotation)",
             &k("angle_deg"),
             l,
-            Some((&k("angle_se_deg"), a.angle_se_deg)),
+            Some((&k("angle_deg_se"), a.angle_deg_se)),
             2,
         )],
         None => vec![vec![
@@ -80,7 +145,7 @@ pub(super) fn verdict_parts(s: &mut Section, v: &Option<VerdictReport>) {
         s.verdict = Some(VerdictView::new(v));
         s.compare = Some(compare_row(v));
         s.method.push(
-            "Verdict: TIR = 2ρ against the tolerance (default ISO 15488 class 1: 10 µm TIR up to 10 mm, 15 µm above); pass when 2(ρ + 2·SE) ≤ tolerance, fail when 2(ρ − 2·SE) > tolerance, else marginal. Tooth radii R_i = |R·u(ψ_i) + e| (methods.md §0, eq. 0.1); largest chip per tooth by the arc model at φ = 90° (eq. 0.4), load share h_i/Σh_j; compensated feed f_z·h_nom/h_max; slot oversize 2·(max R_i − R) (methods.md §1.7). Module runout_core::verdict.".into(),
+            "Verdict: TIR = 2ρ against the tolerance (default ISO 15488 class 1: 10 µm TIR up to 10 mm, 15 µm above); pass when 2(ρ + 2·SE) ≤ tolerance, fail when 2(ρ − 2·SE) > tolerance, else marginal. Tooth radii R_i = |R·u(ψ_i) + e| (docs/methods.md §0, eq. 0.1); largest chip per tooth by the arc model at φ = 90° (eq. 0.4), load share h_i/Σh_j; compensated feed f_z·h_nom/h_max; slot oversize 2·(max R_i − R) (docs/methods.md §1.7).".into(),
         );
     }
 }
@@ -168,7 +233,7 @@ impl ToSection for TeethReport {
             "offset ρ (µm)",
             "/offset_um",
             self.offset_um,
-            Some(("/offset_se_um", self.offset_se_um)),
+            Some(("/offset_um_se", self.offset_um_se)),
             3,
         )];
         res.extend(angle_rows(&self.angle, ""));
@@ -220,10 +285,11 @@ impl ToSection for TeethReport {
         )?);
         s.warnings = self.notes.clone();
         s.method = vec![format!(
-            "Method `{}`: radius differences ΔR_i from the tooth readings (methods.md §1.2, eq. 8), (ρ, λ) by a joint least-squares fit of the exact model R_i = |R·u(ψ_i) + e| (methods.md §1.5); standard errors by error propagation from the noise ({}).",
+            "Method `{}`: radius differences ΔR_i from the tooth readings (docs/methods.md §1.2, eq. 8), (ρ, λ) by a joint least-squares fit of the exact model R_i = |R·u(ψ_i) + e| (docs/methods.md §1.5); standard errors by error propagation from the noise ({}).",
             self.method, self.noise_source
         )];
         verdict_parts(&mut s, &self.verdict);
+        answer_parts(&mut s, &self.answer);
         Ok(s)
     }
 }
@@ -247,14 +313,14 @@ impl ToSection for HeightsReport {
                 "runout at the cutting height (µm)",
                 "/offset_um",
                 self.offset_um,
-                Some(("/offset_se_um", self.offset_se_um)),
+                Some(("/offset_um_se", self.offset_um_se)),
                 3,
             ),
             row(
                 "slope (µm/mm)",
                 "/slope_um_per_mm",
                 self.slope_um_per_mm,
-                Some(("/slope_se_um_per_mm", self.slope_se_um_per_mm)),
+                Some(("/slope_um_per_mm_se", self.slope_um_per_mm_se)),
                 4,
             ),
             row("R²", "/r_squared", self.r_squared, None, 4),
@@ -271,7 +337,7 @@ impl ToSection for HeightsReport {
                 "vector fit: offset (µm)",
                 "/vector/offset_um",
                 v.offset_um,
-                Some(("/vector/offset_se_um", v.offset_se_um)),
+                Some(("/vector/offset_um_se", v.offset_um_se)),
                 3,
             ));
             res.extend(angle_rows(&v.angle, "/vector"));
@@ -289,7 +355,7 @@ impl ToSection for HeightsReport {
                     points: pts.iter().map(|(z, r)| (*z, r * 1e3)).collect(),
                     line: vec![(z0, fit.at(z0) * 1e3), (z1, fit.at(z1) * 1e3)],
                     line_label: format!("{} fit, R² = {:.4}", self.method, fit.r_squared),
-                    at: (fit.height_mm, self.offset_um, self.offset_se_um),
+                    at: (fit.height_mm, self.offset_um, self.offset_um_se),
                     title: "runout vs height (r = TIR/2)".into(),
                 };
                 s.plots.push(Plot {
@@ -305,9 +371,10 @@ impl ToSection for HeightsReport {
         }
         s.warnings.extend(self.notes.iter().cloned());
         s.method = vec![
-            "Runout r = TIR/2 at each height (seed eq. 5); r(z) by ordinary least squares (or the seed's eq. 6), extrapolated to the cutting height (methods.md §1.3); with angles, the offset + tilt vector fit e(z) = e₀ + z·τ (methods.md §1.6).".into(),
+            "Runout r = TIR/2 at each height (seed eq. 5); r(z) by ordinary least squares (or the seed's eq. 6), extrapolated to the cutting height (docs/methods.md §1.3); with angles, the offset + tilt vector fit e(z) = e₀ + z·τ (docs/methods.md §1.6).".into(),
         ];
         verdict_parts(&mut s, &self.verdict);
+        answer_parts(&mut s, &self.answer);
         Ok(s)
     }
 }
@@ -340,7 +407,7 @@ impl ToSection for SignalReport {
             "offset ρ (µm)",
             "/offset_um",
             self.offset_um,
-            Some(("/offset_se_um", Some(self.offset_se_um))),
+            Some(("/offset_um_se", Some(self.offset_um_se))),
             4,
         )];
         res.extend(angle_rows(&self.angle, ""));
@@ -385,9 +452,10 @@ impl ToSection for SignalReport {
         )?);
         s.warnings = self.notes.clone();
         s.method = vec![
-            "First harmonic of the displacement against the spindle angle by linear least squares (methods.md §1.5); TIR/2 per revolution (seed eq. 5); per-tooth extrema with the cutter.".into(),
+            "First harmonic of the displacement against the spindle angle by linear least squares (docs/methods.md §1.5); TIR/2 per revolution (seed eq. 5); per-tooth extrema with the cutter.".into(),
         ];
         verdict_parts(&mut s, &self.verdict);
+        answer_parts(&mut s, &self.answer);
         Ok(s)
     }
 }
@@ -453,7 +521,7 @@ impl ToSection for ForceReport {
                 "offset at the cutting height (µm)",
                 "/runout/offset_um",
                 r.offset_um,
-                Some(("/runout/offset_se_um", Some(r.offset_se_um))),
+                Some(("/runout/offset_um_se", Some(r.offset_um_se))),
                 3,
             ),
             row("angle (deg)", "/runout/angle_deg", r.angle_deg, None, 1),
@@ -475,7 +543,7 @@ impl ToSection for ForceReport {
                 "tilt (µm/mm)",
                 "/runout/tilt_um_per_mm",
                 r.tilt_um_per_mm,
-                Some(("/runout/tilt_se_um_per_mm", Some(r.tilt_se_um_per_mm))),
+                Some(("/runout/tilt_um_per_mm_se", Some(r.tilt_um_per_mm_se))),
                 4,
             ),
         ];
@@ -573,9 +641,10 @@ impl ToSection for ForceReport {
         }
         s.warnings.extend(self.warnings.iter().cloned());
         s.method = vec![
-            "Force from the two-point shank deflection F = K_δ·(δ_II − δ_I) with the beam stiffness (methods.md §3.1) after subtracting the angle-synchronous air-cut template (methods.md §3.2); runout offset and tilt from the air-cut templates of the sensors at two heights.".into(),
+            "Force from the two-point shank deflection F = K_δ·(δ_II − δ_I) with the beam stiffness (docs/methods.md §3.1) after subtracting the angle-synchronous air-cut template (docs/methods.md §3.2); runout offset and tilt from the air-cut templates of the sensors at two heights.".into(),
         ];
         verdict_parts(&mut s, &self.verdict);
+        answer_parts(&mut s, &self.answer);
         Ok(s)
     }
 }
@@ -679,7 +748,7 @@ impl ToSection for CompensateReport {
         if let Some(map) = &self.detail.map {
             s.plots.push(Plot {
                 id: "deviation_heatmap".into(),
-                caption: "Deviation δ (µm) of the probed bar over height u and angle α (methods.md §5.2).".into(),
+                caption: "Deviation δ (µm) of the probed bar over height u and angle α (docs/methods.md §5.2).".into(),
                 svg: runout_io::grind::plot::deviation_heatmap_svg(map)?,
                 shape: "wide",
             });
@@ -712,8 +781,9 @@ impl ToSection for CompensateReport {
         });
         s.warnings = self.grid.notes.clone();
         s.method = vec![
-            "Deviation per probe layer (methods.md §5.2), bar axis offset + tilt by a first-harmonic fit per layer, interpolation along the edge line with periodic wrap (methods.md §5.3), wheel-path offset (methods.md §5.4).".into(),
+            "Deviation per probe layer (docs/methods.md §5.2), bar axis offset + tilt by a first-harmonic fit per layer, interpolation along the edge line with periodic wrap (docs/methods.md §5.3), wheel-path offset (docs/methods.md §5.4).".into(),
         ];
+        answer_parts(&mut s, &self.answer);
         Ok(s)
     }
 }
@@ -784,7 +854,7 @@ impl ToSection for CompareReport {
         ));
         s.warnings = self.warnings.clone();
         s.method = vec![
-            "Exact instantaneous uncut chip thickness by the iterative solver (methods.md §2.2) against the arc and circle models (methods.md §2.3) and the equivalent model with compensation (methods.md §2.4).".into(),
+            "Exact instantaneous uncut chip thickness by the iterative solver (docs/methods.md §2.2) against the arc and circle models (docs/methods.md §2.3) and the equivalent model with compensation (docs/methods.md §2.4).".into(),
         ];
         Ok(s)
     }
@@ -803,7 +873,7 @@ pub(super) fn saved_identify(
     use anyhow::Context;
     let answer = v
         .get("answer")
-        .with_context(|| format!("{name}: no `answer` (expected runout.identify.recording/2)"))?;
+        .with_context(|| format!("{name}: no `answer` (expected runout.identify.recording/3)"))?;
     let verdict: Option<VerdictReport> = match v.get("verdict") {
         Some(x) if !x.is_null() => Some(
             serde_json::from_value::<VerdictReport>(x.clone())
@@ -878,7 +948,7 @@ pub(super) fn saved_identify(
             .into(),
     );
     s.method.push(
-        "Runout and coefficients from the full-signal fit of the averaged force waveforms of all recordings jointly, through the measuring chain (methods.md §4.5–4.7); the per-tooth-peak sine fits are cross-checks (methods.md §4.2).".into(),
+        "Runout and coefficients from the full-signal fit of the averaged force waveforms of all recordings jointly, through the measuring chain (docs/methods.md §4.5–4.7); the per-tooth-peak sine fits are cross-checks (docs/methods.md §4.2).".into(),
     );
     verdict_parts(&mut s, &verdict);
     Ok(s)

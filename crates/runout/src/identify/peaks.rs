@@ -59,6 +59,8 @@ pub struct PeaksInputs {
     pub mode: MillingMode,
     pub peak_immersion_deg: f64,
     pub peaks_N: Vec<f64>,
+    /// Standard errors of the peaks (N).
+    #[serde(rename = "peaks_N_se", alias = "peaks_se_N")]
     pub peaks_se_N: Option<Vec<f64>>,
 }
 
@@ -126,11 +128,11 @@ pub(super) fn error_source_text(e: ErrorSource) -> &'static str {
     }
 }
 
-/// `runout.identify.peaks/1`: the sine fit of one set of per-tooth peaks.
+/// `runout.identify.peaks/2`: the sine fit of one set of per-tooth peaks.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct PeaksReport {
-    /// `runout.identify.peaks/1`
-    #[schemars(extend("const" = "runout.identify.peaks/1"))]
+    /// `runout.identify.peaks/2`
+    #[schemars(extend("const" = "runout.identify.peaks/2"))]
     pub schema: String,
     pub method: String,
     #[serde(flatten)]
@@ -141,7 +143,7 @@ pub struct PeaksReport {
 }
 
 impl Report for PeaksReport {
-    const SCHEMA: &'static str = "runout.identify.peaks/1";
+    const SCHEMA: &'static str = "runout.identify.peaks/2";
 }
 
 /// Peak immersion γ (rad): `explicit_deg` if given, π/2 in a slot, else the angle of the
@@ -203,8 +205,9 @@ pub fn peaks(req: &PeaksRequest) -> Result<PeaksReport> {
     };
     Ok(PeaksReport {
         schema: PeaksReport::SCHEMA.into(),
-        method: "seed003 per-tooth peak sine fit F_i = C + A sin(phi + 2 pi i/K) (methods.md 4.2)"
-            .into(),
+        method:
+            "seed003 per-tooth peak sine fit F_i = C + A sin(phi + 2 pi i/K) (docs/methods.md §4.2)"
+                .into(),
         fit: PeakFitReport::new(&fit, inputs),
         standard_errors: error_source_text(fit.error_source).into(),
         warnings: fit.warnings.clone(),

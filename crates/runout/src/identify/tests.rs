@@ -293,7 +293,7 @@ fn report(r: &MultiTestResult, table: String) -> TestsReport {
     TestsReport {
         schema: TestsReport::SCHEMA.into(),
         table,
-        method: "seed003 per-tooth peak sine fit per test (methods.md 4.2); regressions 4.4; K_T/K_R seed eq. 17 (F_y in the workpiece frame); pooled edge-aware fit 4.6".into(),
+        method: "seed003 per-tooth peak sine fit per test (docs/methods.md §4.2); regressions 4.4; K_T/K_R seed eq. 17 (F_y in the workpiece frame); pooled edge-aware fit 4.6".into(),
         tests: (0..r.tests.len()).map(|i| test_report(r, i)).collect(),
         amplitude_vs_ap: r.amplitude_vs_ap.as_ref().map(Into::into),
         amplitude_vs_ap_origin: r.amplitude_vs_ap_origin.as_ref().map(Into::into),

@@ -19,12 +19,14 @@ pub struct InspectRequest {
     pub sample_rate_hz: Option<f64>,
 }
 
-/// The recording's format.
+/// The recording's format (snake_case: `generic_csv`, `{"dynoware": {…}}`, `{"tdms": {…}}`).
 #[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
 pub enum FormatReport {
     /// A CSV/TSV with a header row.
     GenericCsv,
     /// A Kistler DynoWare text export.
+    #[serde(rename = "dynoware")]
     DynoWare {
         version: String,
     },
@@ -83,11 +85,11 @@ pub struct EntryReport {
     pub note: Option<String>,
 }
 
-/// `runout.inspect/1`: what a recording holds.
+/// `runout.inspect/2`: what a recording holds.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct InspectReport {
-    /// `runout.inspect/1`
-    #[schemars(extend("const" = "runout.inspect/1"))]
+    /// `runout.inspect/2`
+    #[schemars(extend("const" = "runout.inspect/2"))]
     pub schema: String,
     pub file: String,
     pub format: FormatReport,
@@ -97,7 +99,7 @@ pub struct InspectReport {
 }
 
 impl Report for InspectReport {
-    const SCHEMA: &'static str = "runout.inspect/1";
+    const SCHEMA: &'static str = "runout.inspect/2";
 }
 
 /// List what the recording holds.

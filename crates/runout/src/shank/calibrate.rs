@@ -31,32 +31,41 @@ pub struct CalibrateRequest {
     pub sample_rate_hz: Option<f64>,
 }
 
-/// `runout.shank.calibration/1`.
+/// `runout.shank.calibration/2`.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 #[allow(non_snake_case)]
 pub struct CalibrationReport {
-    /// `runout.shank.calibration/1`
-    #[schemars(extend("const" = "runout.shank.calibration/1"))]
+    /// `runout.shank.calibration/2`
+    #[schemars(extend("const" = "runout.shank.calibration/2"))]
     pub schema: String,
+    /// The result first: K_δ ± SE, the status and its reasons, the beam formula as a
+    /// cross-check (issue 21).
+    pub answer: crate::answer::Answer,
     pub recording: String,
     pub steps: usize,
     pub stiffness_N_per_um: f64,
-    pub stiffness_se_N_per_um: f64,
+    pub stiffness_N_per_um_se: f64,
     pub at_load_point_mm: f64,
     pub beam_stiffness_N_per_um: f64,
     pub beam_scale: Option<f64>,
     pub beam_scale_se: Option<f64>,
     pub holder_stiffness_Nm_per_rad: Option<f64>,
     pub holder_compliance_rad_per_Nm: Option<f64>,
-    pub holder_compliance_se_rad_per_Nm: Option<f64>,
+    pub holder_compliance_rad_per_Nm_se: Option<f64>,
     pub offset_um: f64,
     pub residual_rms_um: f64,
     pub r_squared: f64,
     pub condition_number: f64,
 }
 
+impl crate::answer::Answered for CalibrationReport {
+    fn answer(&self) -> &crate::answer::Answer {
+        &self.answer
+    }
+}
+
 impl Report for CalibrationReport {
-    const SCHEMA: &'static str = "runout.shank.calibration/1";
+    const SCHEMA: &'static str = "runout.shank.calibration/2";
 }
 
 /// Fit K_δ (and the holder compliance) to the load steps of the recording.
@@ -107,19 +116,72 @@ pub fn calibrate(req: &CalibrateRequest) -> Result<CalibrationReport> {
         r.setup.beam
     };
     let cal = runout_core::shank::calibrate(&beam, &steps)?;
+    let (k, k_se) = (
+        cal.stiffness_n_per_mm / 1e3,
+        cal.stiffness_se_n_per_mm / 1e3,
+    );
+    let answer = {
+        use crate::answer::{Answer, CrossCheck, Quantity};
+        let reason = crate::answer::se_test(
+            "stiffness K_δ",
+            k,
+            Some(k_se),
+            "N/µm",
+            "load in more steps over a wider force range",
+        )
+        .or_else(|| {
+            (k <= 0.0).then(|| {
+                format!(
+                    "stiffness K_δ = {k:.4} N/µm is not positive: check the sign of the pair \
+                     (sensor_I/sensor_II) and of the force channel"
+                )
+            })
+        });
+        let ok = reason.is_none();
+        Answer {
+            status: Answer::status_of(ok, true).into(),
+            method: format!(
+                "least squares of the load cell's force against the deflection difference \
+                 δ_II − δ_I over {} samples (docs/methods.md §3.1)",
+                cal.steps
+            ),
+            runout: None,
+            results: vec![if ok {
+                Quantity::identified("stiffness K_δ", "N/µm", k, Some(k_se))
+            } else {
+                Quantity::not_identified("stiffness K_δ", "N/µm")
+            }],
+            reasons: reason.into_iter().collect(),
+            warnings: Vec::new(),
+            cross_checks: vec![CrossCheck {
+                estimate: "beam formula from the shank's diameter, modulus and lengths".into(),
+                values: vec![Quantity::cross_check(
+                    "stiffness K_δ",
+                    "N/µm",
+                    beam.stiffness_n_per_um(),
+                    None,
+                )],
+                why_it_may_differ: "the formula assumes a rigid holder and the nominal modulus \
+                                    and diameter; the holder's compliance and the flutes lower \
+                                    the measured stiffness"
+                    .into(),
+            }],
+        }
+    };
     Ok(CalibrationReport {
         schema: CalibrationReport::SCHEMA.into(),
+        answer,
         recording: info.file,
         steps: cal.steps,
         stiffness_N_per_um: cal.stiffness_n_per_mm / 1e3,
-        stiffness_se_N_per_um: cal.stiffness_se_n_per_mm / 1e3,
+        stiffness_N_per_um_se: cal.stiffness_se_n_per_mm / 1e3,
         at_load_point_mm: beam.load_distance_mm(),
         beam_stiffness_N_per_um: beam.stiffness_n_per_um(),
         beam_scale: cal.beam_scale.map(|b| b.0),
         beam_scale_se: cal.beam_scale.map(|b| b.1),
         holder_stiffness_Nm_per_rad: cal.holder_compliance_rad_per_nmm.map(|c| 1.0 / c.0 / 1e3),
         holder_compliance_rad_per_Nm: cal.holder_compliance_rad_per_nmm.map(|c| c.0 * 1e3),
-        holder_compliance_se_rad_per_Nm: cal.holder_compliance_rad_per_nmm.map(|c| c.1 * 1e3),
+        holder_compliance_rad_per_Nm_se: cal.holder_compliance_rad_per_nmm.map(|c| c.1 * 1e3),
         offset_um: cal.offset_mm * 1e3,
         residual_rms_um: cal.residual_rms_mm * 1e3,
         r_squared: cal.r_squared,

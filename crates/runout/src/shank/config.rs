@@ -92,7 +92,7 @@ pub(crate) fn load_config(config: &Source, rate: Option<f64>) -> Result<Resolved
         }
         None => (
             beam.stiffness_n_per_mm(),
-            "beam formula (methods.md 3.1)".to_string(),
+            "beam formula (docs/methods.md §3.1)".to_string(),
         ),
     };
     if cfg.pair.is_empty() || cfg.pair.len() > 2 {

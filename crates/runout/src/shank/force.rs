@@ -98,13 +98,15 @@ pub struct SensorRunout {
 #[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct RunoutReport {
     pub offset_um: f64,
-    pub offset_se_um: f64,
+    #[serde(alias = "offset_se_um")]
+    pub offset_um_se: f64,
     pub angle_deg: f64,
     pub at_height_above_tip_mm: f64,
     pub tip_offset_um: f64,
     pub tip_angle_deg: f64,
     pub tilt_um_per_mm: f64,
-    pub tilt_se_um_per_mm: f64,
+    #[serde(alias = "tilt_se_um_per_mm")]
+    pub tilt_um_per_mm_se: f64,
     pub tilt_angle_deg: f64,
     pub angle_reference: String,
     pub per_sensor: Vec<SensorRunout>,
@@ -192,12 +194,16 @@ pub struct OutputReport {
     pub columns: Vec<String>,
 }
 
-/// `runout.shank.force/1`: force, deflections and runout from a shank recording.
+/// `runout.shank.force/2`: force, deflections and runout from a shank recording.
 #[derive(Debug, Clone, Serialize, Deserialize, JsonSchema)]
 pub struct ForceReport {
-    /// `runout.shank.force/1`
-    #[schemars(extend("const" = "runout.shank.force/1"))]
+    /// `runout.shank.force/2`
+    #[schemars(extend("const" = "runout.shank.force/2"))]
     pub schema: String,
+    /// The result first: the runout offset ρ ± SE and tilt ± SE from the air cuts, the mean
+    /// forces over the cut, the status and its reasons (issue 21).
+    #[serde(default)]
+    pub answer: crate::answer::Answer,
     pub recording: String,
     pub format: String,
     pub samples: u64,
@@ -230,7 +236,7 @@ pub struct ForceReport {
 }
 
 impl Report for ForceReport {
-    const SCHEMA: &'static str = "runout.shank.force/1";
+    const SCHEMA: &'static str = "runout.shank.force/2";
 }
 
 /// The data behind the plots of `shank force`, thinned to a bounded size.
@@ -556,12 +562,13 @@ pub fn force_to(
     let mut analysis = analysis;
     analysis.spectral_resonance = rec.spectral_resonance();
     warnings.extend(analysis.warnings.iter().cloned());
+    let mut not_to_use = Vec::new();
     for (p, (a, b)) in r.setup.pairs.iter().zip(&senses) {
         let axis = p.axis.letter().to_string();
         if let Some(f) = runout_core::plausibility::sensor_senses(a, b, &axis) {
-            warnings.push(format!(
-                "{f} (the forces and the runout of this recording are not to be used)"
-            ));
+            let w = format!("{f} (the forces and the runout of this recording are not to be used)");
+            warnings.push(w.clone());
+            not_to_use.push(w);
         }
     }
     let axes: Vec<PairAxis> = r.setup.pairs.iter().map(|p| p.axis).collect();
@@ -603,7 +610,111 @@ pub fn force_to(
         zoomed,
         templates: analysis.templates.iter().map(|t| t.bins.clone()).collect(),
     };
+    report.answer = force_answer(&report, r.setup.has_pulse, not_to_use);
     Ok(report)
+}
+
+/// The answer of `shank force` (issue 21 item 1): ρ ± SE and the tilt ± SE from the air-cut
+/// templates (SE test: `crate::answer::se_test`), and the mean force per axis over the cut.
+/// `not identified` when the sensors of a pair move in opposite senses (`reasons`: the forces
+/// and the runout are not to be used) or ρ fails its SE or size test. Without a pulse channel
+/// the angle has an arbitrary origin: reported `not measured`, which does not lower the status
+/// (the input cannot give it). The runout at each sensor height is a cross-check.
+fn force_answer(
+    r: &ForceReport,
+    has_pulse: bool,
+    not_to_use: Vec<String>,
+) -> crate::answer::Answer {
+    use crate::answer::{Answer, CrossCheck, Quantity, RunoutAnswer, NOT_IDENTIFIED};
+    use runout_core::plausibility::{runout_size, Severity};
+    let ro = &r.runout;
+    let mut reasons = not_to_use;
+    let mut warnings = Vec::new();
+    let forces_ok = reasons.is_empty();
+    if let Some(x) = crate::answer::se_test(
+        "runout ρ",
+        ro.offset_um,
+        Some(ro.offset_um_se),
+        "µm",
+        "record longer air cuts (more revolutions) before and after the cut",
+    ) {
+        reasons.push(x);
+    }
+    for f in runout_size(ro.offset_um * 1e-3, r.beam.diameter_mm / 2.0, 0.0) {
+        match f.severity {
+            Severity::NotIdentified => reasons.push(f.to_string()),
+            Severity::Warning => warnings.push(f.to_string()),
+        }
+    }
+    if r.saturated_samples > 0 {
+        warnings.push(format!(
+            "{} samples saturated (a sensor at its range limit): check the sensors' range and \
+             distance to the shank",
+            r.saturated_samples
+        ));
+    }
+    let rho_ok = reasons.is_empty();
+    let mut results = vec![if rho_ok {
+        Quantity::identified(
+            "tilt",
+            "µm/mm",
+            ro.tilt_um_per_mm,
+            Some(ro.tilt_um_per_mm_se),
+        )
+    } else {
+        Quantity::not_identified("tilt", "µm/mm")
+    }];
+    for a in &r.force_over_cut {
+        let name = format!("mean force F_{} over the cut", a.axis);
+        results.push(if forces_ok {
+            Quantity::identified(&name, "N", a.mean_N, None)
+        } else {
+            Quantity::not_identified(&name, "N")
+        });
+    }
+    Answer {
+        status: Answer::status_of(rho_ok, true).into(),
+        method: "runout offset + tilt from the air-cut templates of the sensors at two heights; \
+                 force F = K_δ·(δ_II − δ_I) after subtracting the air-cut template \
+                 (docs/methods.md §3.1, §3.2)"
+            .into(),
+        runout: Some(RunoutAnswer {
+            offset_um: rho_ok.then_some(ro.offset_um),
+            offset_um_se: rho_ok.then_some(ro.offset_um_se),
+            angle_deg: (rho_ok && has_pulse).then_some(ro.angle_deg),
+            angle_deg_se: None,
+            angle: if !rho_ok {
+                NOT_IDENTIFIED.into()
+            } else if has_pulse {
+                "identified (from the pulse mark; no SE)".into()
+            } else {
+                "not measured (no pulse channel: the angle origin is arbitrary)".into()
+            },
+        }),
+        results,
+        reasons,
+        warnings,
+        cross_checks: ro
+            .per_sensor
+            .iter()
+            .map(|p| CrossCheck {
+                estimate: format!(
+                    "runout at the sensor {:.1} mm above the tip",
+                    p.height_above_tip_mm
+                ),
+                values: vec![Quantity::cross_check("runout", "µm", p.runout_um, None)],
+                why_it_may_differ: "at the sensor's height, not the cutting height: differs from \
+                                    ρ by the tilt times the height difference"
+                    .into(),
+            })
+            .collect(),
+    }
+}
+
+impl crate::answer::Answered for ForceReport {
+    fn answer(&self) -> &crate::answer::Answer {
+        &self.answer
+    }
 }
 
 fn scale_chunk(chunk: &mut RecordingChunk, scales: &[f64]) {
@@ -653,7 +764,7 @@ fn summary(
     let mut report = ForceReport {
         schema: ForceReport::SCHEMA.into(),
         recording: info.file.clone(),
-        format: format!("{:?}", info.format),
+        format: crate::words::serde_name(&info.format),
         samples,
         sample_rate_hz: fs,
         duration_s: samples as f64 / fs,
@@ -694,13 +805,13 @@ fn summary(
         air_residual_rms_um: an.air_residual_rms_mm.iter().map(|v| v * 1e3).collect(),
         runout: RunoutReport {
             offset_um: ro.offset_magnitude_mm() * 1e3,
-            offset_se_um: ro.offset_se_mm * 1e3,
+            offset_um_se: ro.offset_se_mm * 1e3,
             angle_deg: ro.offset_angle_rad().to_degrees(),
             at_height_above_tip_mm: ro.cutting_height_mm,
             tip_offset_um: ro.tip_offset_mm.0.hypot(ro.tip_offset_mm.1) * 1e3,
             tip_angle_deg: deg(ro.tip_offset_mm.0, ro.tip_offset_mm.1),
             tilt_um_per_mm: ro.tilt_magnitude() * 1e3,
-            tilt_se_um_per_mm: ro.tilt_se * 1e3,
+            tilt_um_per_mm_se: ro.tilt_se * 1e3,
             tilt_angle_deg: ro.tilt_angle_rad().to_degrees(),
             angle_reference: angle_ref.into(),
             per_sensor: ro
@@ -755,6 +866,7 @@ fn summary(
         }),
         warnings,
         verdict: None,
+        answer: crate::answer::Answer::default(),
         plot: ForcePlotData::default(),
     };
     match verdict_of(&report, s.has_pulse) {
@@ -773,7 +885,7 @@ fn verdict_of(r: &ForceReport, has_pulse: bool) -> Result<VerdictReport> {
     let v = VerdictReport::new(
         VerdictBasis {
             offset_um: ro.offset_um,
-            offset_se_um: Some(ro.offset_se_um),
+            offset_um_se: Some(ro.offset_um_se),
             angle_deg: has_pulse.then_some(ro.angle_deg),
             teeth: r.dynamics.teeth,
             diameter_mm: Some(r.beam.diameter_mm),

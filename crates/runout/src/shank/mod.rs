@@ -121,6 +121,6 @@ pub fn stiffness(req: &StiffnessRequest) -> Result<StiffnessReport> {
             l1_mm: beam.l1_mm,
             l2_mm: beam.l2_mm,
         },
-        formula: "K = 6EI / [l2^2(3a - l2) - l1^2(3a - l1) + 6EI(l2 - l1)a/k_theta], I = pi d^4/64 (methods.md 3.1)".into(),
+        formula: "K = 6EI / [l2^2(3a - l2) - l1^2(3a - l1) + 6EI(l2 - l1)a/k_theta], I = pi d^4/64 (docs/methods.md §3.1)".into(),
     })
 }

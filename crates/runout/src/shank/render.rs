@@ -28,17 +28,21 @@ pub fn stiffness_text(r: &StiffnessReport) -> String {
 
 /// `runout shank calibrate` text.
 pub fn calibration_text(r: &CalibrationReport) -> String {
+    r.answer.text() + &calibration_body(r)
+}
+
+fn calibration_body(r: &CalibrationReport) -> String {
     let mut s = format!(
         "K_delta = {:.4} ± {:.4} N/um at {} mm (beam formula {:.4}); R² {:.6}, residual {:.3} um, condition {:.1}\n",
         r.stiffness_N_per_um,
-        r.stiffness_se_N_per_um,
+        r.stiffness_N_per_um_se,
         r.at_load_point_mm,
         r.beam_stiffness_N_per_um,
         r.r_squared,
         r.residual_rms_um,
         r.condition_number
     );
-    match (r.holder_compliance_rad_per_Nm, r.holder_compliance_se_rad_per_Nm) {
+    match (r.holder_compliance_rad_per_Nm, r.holder_compliance_rad_per_Nm_se) {
         (Some(c), Some(se)) => {
             s += &format!("holder: rotational compliance {c:.4e} ± {se:.1e} rad/(N·m)\n")
         }
@@ -48,7 +52,11 @@ pub fn calibration_text(r: &CalibrationReport) -> String {
 }
 
 /// `runout shank force` text summary.
-pub fn force_text(j_: &ForceReport) -> String {
+pub fn force_text(r: &ForceReport) -> String {
+    r.answer.text() + &force_body(r)
+}
+
+fn force_body(j_: &ForceReport) -> String {
     let mut s = String::new();
     let r = &j_.runout;
     let _ = writeln!(
@@ -78,7 +86,7 @@ pub fn force_text(j_: &ForceReport) -> String {
         s,
         "runout           offset {:.2} ± {:.2} um at {} mm above the tip, angle {:.1} deg; tilt {:.3} um/mm at {:.1} deg",
         r.offset_um,
-        r.offset_se_um,
+        r.offset_um_se,
         j(r.at_height_above_tip_mm),
         r.angle_deg,
         r.tilt_um_per_mm,

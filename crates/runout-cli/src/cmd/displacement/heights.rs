@@ -47,6 +47,7 @@ pub fn run(a: Args) -> Result<()> {
         method,
     })?;
     a.out.report.judge(&mut report)?;
+    crate::exit::from_answer(&report);
     if let Some(p) = &plot {
         a.out.plots.create_dir()?;
         render::heights_plot(p, &report)?;

@@ -130,8 +130,11 @@ pub fn run(a: Args) -> Result<()> {
         hole_path_mm,
     };
     let plot = a.out.check(&a.recording, "signal")?;
+    let spin = crate::progress::Spinner::new("fitting the displacement signal");
     let mut report = signal(&req)?;
+    drop(spin);
     a.out.report.judge(&mut report)?;
+    crate::exit::from_answer(&report);
     if let Some(p) = &plot {
         a.out.plots.create_dir()?;
         render::signal_plot(p, &report)?;

@@ -76,6 +76,7 @@ pub fn run(a: Args) -> Result<()> {
         hole_path_mm,
     })?;
     a.out.report.judge(&mut report)?;
+    crate::exit::from_answer(&report);
     if let Some(p) = &plot {
         a.out.plots.create_dir()?;
         render::teeth_plot(p, &report)?;

@@ -91,6 +91,7 @@ pub fn run(a: CheckArgs) -> Result<()> {
     if !a.edge.generated() {
         bail!("--edge: the check generates its edge: flat | ball");
     }
+    let spin = crate::progress::Spinner::new("simulating the grind");
     let report = check(&CheckRequest {
         bar_diameter_mm,
         offset_um,
@@ -104,6 +105,8 @@ pub fn run(a: CheckArgs) -> Result<()> {
         range,
         edge: a.edge.generated_edge()?,
     })?;
+    drop(spin);
+    crate::exit::from_answer(&report);
     if let Some(j) = &a.json {
         output::write_text(j, &crate::provenance::stamped_json(&report)?)?;
         if j.as_os_str() == "-" {

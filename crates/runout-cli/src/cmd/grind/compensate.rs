@@ -218,6 +218,7 @@ pub fn compensate_cmd(a: CompensateArgs) -> Result<()> {
         edge,
         nc,
     })?;
+    crate::exit::from_answer(&report);
     if let (Some(out), Some(text)) = (&a.out, &report.detail.nc_text) {
         output::write_text(out, text)?;
     }

@@ -40,7 +40,7 @@ pub struct Args {
     /// (methods.md §4.3). Default: the K peaks once each (plain least squares).
     #[arg(long)]
     pub closed_period: bool,
-    /// Write the JSON result (schema runout.identify.peaks/1); `-` for stdout.
+    /// Write the JSON result (schema runout.identify.peaks/2); `-` for stdout.
     #[arg(long, allow_hyphen_values = true)]
     pub json: Option<PathBuf>,
 }

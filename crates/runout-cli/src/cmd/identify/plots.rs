@@ -118,8 +118,8 @@ pub fn write(dir: &Path, ext: &str, r: &RecordingsReport) -> Result<()> {
             label: l,
             offset_um: *o,
             angle_deg: *a,
-            offset_se_um: ose.unwrap_or(f64::NAN),
-            angle_se_deg: ase.unwrap_or(f64::NAN),
+            offset_um_se: ose.unwrap_or(f64::NAN),
+            angle_deg_se: ase.unwrap_or(f64::NAN),
         })
         .collect();
     runout_polar(

@@ -149,7 +149,7 @@ pub fn run(a: RecordingArgs) -> Result<()> {
     // assumed defaults that change the answer, on stderr too (after the job: an input error
     // stays a plain `error: …` message)
     for w in &req.assumed {
-        eprintln!("warning: {w}");
+        crate::progress::warn(w);
     }
     if report.answer.status != "identified" {
         crate::exit::not_identified();

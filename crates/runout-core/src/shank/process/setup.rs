@@ -160,7 +160,7 @@ impl ShankSetup {
         if self.min_air_revolutions < 5 {
             return Err(p(
                 "min_air_revolutions",
-                "≥ 5 (methods.md §3.2 step 3)",
+                "≥ 5 (docs/methods.md §3.2 step 3)",
                 self.min_air_revolutions.to_string(),
             ));
         }

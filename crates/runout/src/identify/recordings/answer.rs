@@ -17,12 +17,7 @@ use runout_core::CuttingCoefficients;
 use schemars::JsonSchema;
 use serde::Serialize;
 
-/// `identified`.
-pub const IDENTIFIED: &str = "identified";
-/// `partly identified`.
-pub const PARTLY: &str = "partly identified";
-/// `not identified`.
-pub const NOT_IDENTIFIED: &str = "not identified";
+pub use crate::answer::{IDENTIFIED, NOT_IDENTIFIED, PARTLY};
 
 /// The runout of the answer; values only when identified.
 #[derive(Debug, Clone, Serialize, JsonSchema)]
@@ -93,7 +88,7 @@ fn words(f: &Finding) -> String {
 }
 
 /// Guards on the recordings themselves: clipped channels, the same data twice, teeth × rpm
-/// against the spectrum.
+/// against the spectrum, the forces' magnitude against the cut (diameter, teeth, a_p, f_z).
 pub(super) fn data_findings(req: &RecordingsRequest, files: &[FileResult]) -> Vec<Finding> {
     let mut out: Vec<Finding> = files.iter().flat_map(|f| f.clipped.clone()).collect();
     let items: Vec<(String, u64)> = files
@@ -104,6 +99,19 @@ pub(super) fn data_findings(req: &RecordingsRequest, files: &[FileResult]) -> Ve
     let k = req.cutter.teeth();
     for f in files {
         if let Some(x) = teeth_rpm(&f.name, k, f.cut.rpm(), f.analysis.scan.tooth_passing.hz) {
+            out.push(x);
+        }
+        let (st, ex) = f.cut.immersion(&req.cutter);
+        if let Some(x) = plausibility::force_magnitude(
+            &f.name,
+            f.mean_force[0].hypot(f.mean_force[1]),
+            k,
+            f.cut.ap(),
+            f.cut.fz(),
+            st,
+            ex,
+            req.cutter.diameter(),
+        ) {
             out.push(x);
         }
     }

@@ -1,4 +1,4 @@
-//! The report of `identify RECORDING…` (`runout.identify.recording/2`) and its construction.
+//! The report of `identify RECORDING…` (`runout.identify.recording/3`) and its construction.
 
 use super::fit::{
     fitted_radius_difference_um, model_waveforms, radius_difference_um, radius_difference_warnings,
@@ -241,12 +241,12 @@ pub struct WaveformPlot {
     pub components: usize,
 }
 
-/// `runout.identify.recording/2`: runout and cutting coefficients from force recordings.
+/// `runout.identify.recording/3`: runout and cutting coefficients from force recordings.
 /// (`/2` added `answer`, the one result to use, first.)
 #[derive(Debug, Clone, Serialize, JsonSchema)]
 pub struct RecordingsReport {
-    /// `runout.identify.recording/2`
-    #[schemars(extend("const" = "runout.identify.recording/2"))]
+    /// `runout.identify.recording/3`
+    #[schemars(extend("const" = "runout.identify.recording/3"))]
     pub schema: String,
     /// The one answer: runout ρ ± SE, λ ± SE, the method, the status (`identified` /
     /// `partly identified` / `not identified`) with the reasons, the coefficients each with its
@@ -273,7 +273,7 @@ pub struct RecordingsReport {
 }
 
 impl Report for RecordingsReport {
-    const SCHEMA: &'static str = "runout.identify.recording/2";
+    const SCHEMA: &'static str = "runout.identify.recording/3";
 }
 
 const DEG: f64 = 57.29577951308232; // 1f64.to_degrees()
@@ -293,7 +293,7 @@ fn sine_report(s: &Result<SineFit, String>) -> Fitted<SineFitReport> {
     let (offset_um, offset_um_se) = est(f.offset.value, f.offset.se, 1e3);
     let (angle_deg, angle_deg_se) = est(f.angle.value, f.angle.se, DEG);
     Fitted::Fit(SineFitReport {
-        method: "seed 003 sine fit of per-tooth peaks (methods.md §4.2)".into(),
+        method: "seed 003 sine fit of per-tooth peaks (docs/methods.md §4.2)".into(),
         mean_N,
         mean_N_se,
         amplitude_N,
@@ -372,7 +372,7 @@ fn recording_report(req: &RecordingsRequest, f: &FileResult) -> RecordingReport 
             rpm_se: a.speed.rpm_se,
             nominal_rpm: a.speed.nominal_rpm,
             deviation_percent: 100.0 * a.speed.deviation,
-            method: format!("{:?}", a.speed.method),
+            method: crate::words::snake(&a.speed.method),
         },
         section: SectionReport {
             from_s: a.scan.section.from_s,
@@ -387,7 +387,7 @@ fn recording_report(req: &RecordingsRequest, f: &FileResult) -> RecordingReport 
             fy: f.mean_force[1],
             fz: f.mean_force[2].is_finite().then_some(f.mean_force[2]),
         },
-        peak_component: format!("{:?}", a.average.peak_component),
+        peak_component: crate::words::snake(&a.average.peak_component),
         tooth_peaks: a
             .average
             .tooth_peaks
@@ -527,7 +527,7 @@ fn verdict_of(r: &RecordingsReport) -> anyhow::Result<Option<crate::verdict::Ver
     crate::verdict::VerdictReport::new(
         crate::verdict::VerdictBasis {
             offset_um: f.offset_um,
-            offset_se_um: f.offset_um_se,
+            offset_um_se: f.offset_um_se,
             angle_deg: Some(f.angle_deg),
             teeth: Some(r.inputs.teeth),
             diameter_mm: Some(r.inputs.diameter_mm),
