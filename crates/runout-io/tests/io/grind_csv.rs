@@ -39,7 +39,7 @@ fn reads_a_probe_grid_with_line_numbers() {
     // data start on line 3 (comment line 1, header line 2)
     assert_eq!(g.layers[0].rows, vec![3, 4, 5, 6]);
     let m = DeviationMap::new(&g);
-    assert!((m.axis.offset[0] - 0.006).abs() < 1e-12);
+    assert!((m.axis.offset[0].value - 0.006).abs() < 1e-12);
 }
 
 #[test]
