@@ -174,9 +174,9 @@ const ROWS: &[Row] = &[
           expect: &["missing/p.svg", "folder `{d}/missing` does not exist; create it or choose another path"] },
     // ---- grind: probe and edge tables, NC programs ----
     Row { name: "probe table with an unknown column", files: &[("probe.csv", Edit("grind/probe.csv", "angle_deg", "angle_grad")), EDGE],
-          args: GRIND, expect: &["probe.csv, line 3", "unknown column `angle_grad`"] },
+          args: GRIND, expect: &["probe.csv:3: ", "unknown column `angle_grad`"] },
     Row { name: "probe cell not a number", files: &[("probe.csv", Edit("grind/probe.csv", "4.008611", "4.0O8611")), EDGE],
-          args: GRIND, expect: &["probe.csv, line 4", "`4.0O8611`", "not a finite number"] },
+          args: GRIND, expect: &["probe.csv:4:", "`4.0O8611` in column `x_mm` is not a number"] },
     Row { name: "edge table without z", files: &[PROBE, ("edge.csv", Edit("grind/edge.csv", "x_mm,y_mm,z_mm", "x_mm,y_mm,w_mm"))],
           args: GRIND, expect: &["edge.csv", "w_mm"] },
     Row { name: "NC word without a number", files: &[PROBE, EDGE, ("flute.nc", Edit("grind/flute.nc", "N50 G1 X1.9176", "N50 G1 X"))],

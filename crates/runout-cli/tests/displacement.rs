@@ -146,7 +146,10 @@ fn teeth_errors() {
         .output()
         .unwrap();
     let e = String::from_utf8_lossy(&out.stderr);
-    assert!(e.contains("nan.csv:3: column `reading_um`"), "{e}");
+    assert!(
+        e.contains("nan.csv:3:2: ") && e.contains("column `reading_um`"),
+        "{e}"
+    );
     let p = write(d.path(), "ok.csv", "tooth,reading_um\n0,1\n1,2\n2,3\n");
     let out = runout()
         .args([
