@@ -350,7 +350,7 @@ impl Table {
         })?;
         if !(v * col.factor).is_finite() {
             return Err(at(format!(
-                "`{quoted}` in column `{}` is not a finite number",
+                "`{quoted}` in column `{}` is not finite (expected a finite number)",
                 col.name
             )));
         }
