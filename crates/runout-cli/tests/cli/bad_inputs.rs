@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::*;
 
 /// Content of an input file of a row.
@@ -55,10 +55,10 @@ const CUT: (&str, Src) = (
     Edit("identify/cut.toml", "fz_mm = [0.05, 0.08]", "fz_mm = 0.05"),
 );
 const SHANK_CFG: (&str, Src) = ("shank.toml", Text(SHANK_TOML));
-const SHANK_TOML: &str = include_str!("data/shank.toml");
+const SHANK_TOML: &str = include_str!("../data/shank.toml");
 const SHANK_REC: (&str, Src) = (
     "rec.csv",
-    Text(include_str!("data/issue20/shank_recording.csv")),
+    Text(include_str!("../data/issue20/shank_recording.csv")),
 );
 const GRIND: &str = "grind compensate --probe {d}/probe.csv --bar-diameter-mm 6 --probe-tip-radius-mm 1 \
                      --edge {d}/edge.csv --json {d}/g.json --path-out {d}/path.csv --plots {d}/plots";

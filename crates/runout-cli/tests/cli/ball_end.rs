@@ -13,7 +13,7 @@ use runout_core::*;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::*;
 
 const FS: f64 = 50_000.0;

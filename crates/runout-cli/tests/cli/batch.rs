@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-mod common;
+use crate::common;
 use common::*;
 
 const CONFIG: &str = "teeth = 4\ndiameter_mm = 10.0\nhelix_deg = 0.0\nrpm = 3240\nfz_mm = 0.05\nap_mm = 2.0\nae_mm = 2.0\nmode = \"down\"\naxes = \"x = Fx, y = Fy, z = Fz\"\npeak_component = \"fxy\"\n";

@@ -3,7 +3,7 @@
 use std::fs;
 use std::path::PathBuf;
 
-mod common;
+use crate::common;
 use common::*;
 
 fn chip_example(name: &str) -> PathBuf {

@@ -4,7 +4,7 @@ use std::f64::consts::{PI, TAU};
 use std::fs;
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::*;
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

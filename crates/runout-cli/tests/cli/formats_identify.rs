@@ -8,7 +8,7 @@
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::*;
 
 const FEEDS: [&str; 2] = ["cut_fz0.05.txt", "cut_fz0.08.txt"];

@@ -1,6 +1,6 @@
 //! `runout grind compensate` end to end on the shipped example (examples/grind).
 
-mod common;
+use crate::common;
 use common::*;
 
 fn ex(name: &str) -> String {

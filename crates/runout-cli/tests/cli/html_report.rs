@@ -6,7 +6,7 @@
 //! and every plot present as inline SVG. The same page rendered by headless Chromium (no console
 //! error, the verdict and plots in the DOM, a screenshot) is the ignored test at the end.
 
-mod common;
+use crate::common;
 use common::{example, runout};
 use serde_json::Value;
 use std::path::{Path, PathBuf};

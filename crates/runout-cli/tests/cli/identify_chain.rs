@@ -9,7 +9,7 @@
 
 use std::path::PathBuf;
 
-mod common;
+use crate::common;
 use common::*;
 
 /// Five feeds where one recording alone still places the runout (its information scales with

@@ -3,7 +3,7 @@
 use predicates::prelude::*;
 use serde_json::Value;
 
-mod common;
+use crate::common;
 use common::*;
 
 fn json_of(args: &[&str]) -> Value {

@@ -7,7 +7,7 @@ use runout_io::export::{write_dynoware, Channel, TextStyle};
 use std::fs;
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::*;
 
 fn stiffness_json(args: &[&str]) -> serde_json::Value {

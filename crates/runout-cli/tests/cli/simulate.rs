@@ -2,7 +2,7 @@
 
 use std::fs;
 
-mod common;
+use crate::common;
 use common::*;
 
 #[test]

@@ -18,7 +18,7 @@ use runout_core::chain::{Complex64, SensorMode};
 use std::f64::consts::TAU;
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::*;
 
 const CASE: [&str; 27] = [

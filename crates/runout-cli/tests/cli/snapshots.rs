@@ -13,7 +13,7 @@ use std::f64::consts::{PI, TAU};
 use std::fs;
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::*;
 
 /// Run `runout ARGS` from the repository root; its stdout with `tmp` replaced by `[TMP]`.
