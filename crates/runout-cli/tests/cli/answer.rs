@@ -183,7 +183,7 @@ fn bull_nose_cut_identified_as_flat_is_not_identified_exit_3() {
     let mut files = Vec::new();
     for fz in ["0.05", "0.08"] {
         let f = dir.path().join(format!("bn_{fz}.txt"));
-        let s = runout()
+        runout()
             .args([
                 "simulate",
                 "--teeth",
@@ -233,9 +233,7 @@ fn bull_nose_cut_identified_as_flat_is_not_identified_exit_3() {
                 "--recording",
             ])
             .arg(&f)
-            .output()
-            .unwrap();
-        assert!(s.status.success(), "{}", String::from_utf8_lossy(&s.stderr));
+            .success_output();
         files.push(f);
     }
     let refs: Vec<&Path> = files.iter().map(|p| p.as_path()).collect();

@@ -391,12 +391,7 @@ fn a_successful_command_does_write_its_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path().to_str().unwrap();
     let line = format!("{SIM} {SIM_OUT}").replace("{d}", d);
-    let out = runout().args(line.split_whitespace()).output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    runout().args(line.split_whitespace()).success_output();
     let files = snapshot(dir.path());
     for f in ["forces.csv", "sim.json", "forces.svg"] {
         assert!(

@@ -121,13 +121,7 @@ fn identify(files: &[PathBuf], fz: &str, extra: &[&str]) -> serde_json::Value {
             "-",
         ])
         .args(extra)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -288,13 +282,7 @@ fn simulate_with_a_ball_profile() {
                 "--json",
                 "-",
             ])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+            .success_output();
         serde_json::from_slice(&out.stdout).unwrap()
     };
     let ball = run("ball");

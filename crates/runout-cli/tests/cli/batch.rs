@@ -17,7 +17,7 @@ fn base_recordings(dir: &Path) -> Vec<PathBuf> {
     (0..8)
         .map(|i| {
             let p = dir.join(format!("base{i}.txt"));
-            let out = runout()
+            runout()
                 .args([
                     "simulate",
                     "--teeth",
@@ -51,13 +51,7 @@ fn base_recordings(dir: &Path) -> Vec<PathBuf> {
                 .arg(format!("{}", i + 1))
                 .arg("--recording")
                 .arg(&p)
-                .output()
-                .unwrap();
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
+                .success_output();
             p
         })
         .collect()
@@ -87,13 +81,7 @@ fn batch(args: &[&str], dir: &Path) -> serde_json::Value {
         .arg("batch")
         .args(args)
         .args(["--json", "-"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -148,9 +136,7 @@ fn two_hundred_recordings_some_broken_resumable_and_throughput() {
                 "--json",
                 "-",
             ])
-            .output()
-            .unwrap();
-        assert!(out.status.success());
+            .success_output();
         let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         reference.push(v["full_signal"].clone());
     }

@@ -20,13 +20,7 @@ fn compare_shipped_case_set_meets_accuracy_target() {
         .args(["chip", "compare"])
         .arg(chip_example("section2_5.toml"))
         .args(["--json", "-"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let v = json_of(&out.stdout);
     assert_eq!(v["schema"], "runout.chip.compare/1");
     assert_eq!(v["cases"].as_array().unwrap().len(), 9);
@@ -49,9 +43,7 @@ fn compare_text_states_both_metrics_and_fit() {
         .args(["chip", "compare"])
         .arg(chip_example("section2_5.toml"))
         .args(["--case", "K3", "--fit-k"])
-        .output()
-        .unwrap();
-    assert!(out.status.success());
+        .success_output();
     let s = String::from_utf8_lossy(&out.stdout);
     assert!(
         s.contains("mean |Δh|/h") && s.contains("normalised MAE"),
@@ -77,13 +69,7 @@ fn eval_path_writes_csv_plots_and_json() {
         .arg("--map")
         .arg(&map)
         .args(["--json", "-"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let v = json_of(&out.stdout);
     assert_eq!(v["schema"], "runout.chip.eval/1");
     assert_eq!(v["motion"], "path");
@@ -110,9 +96,7 @@ fn eval_rejects_unknown_model_and_bad_height() {
         .args(["chip", "eval"])
         .arg(chip_example("section2_5.toml"))
         .args(["--model", "magic"])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
+        .failure_output();
     assert!(String::from_utf8_lossy(&out.stderr).contains("--model"));
     let dir = tempfile::tempdir().unwrap();
     let out = runout()
@@ -121,9 +105,7 @@ fn eval_rejects_unknown_model_and_bad_height() {
         .arg("--plot")
         .arg(dir.path().join("p.svg"))
         .args(["--plot-height-mm", "3.3"])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
+        .failure_output();
     assert!(String::from_utf8_lossy(&out.stderr).contains("--plot-height-mm"));
 }
 
@@ -135,9 +117,7 @@ fn bad_case_files_name_file_case_and_key() {
     let out = runout()
         .args(["chip", "compare"])
         .arg(&cfg)
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
+        .failure_output();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("bad.toml") && err.contains("case `a`") && err.contains("motion"),
@@ -147,9 +127,7 @@ fn bad_case_files_name_file_case_and_key() {
     let out = runout()
         .args(["chip", "compare"])
         .arg(&cfg)
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
+        .failure_output();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("fz_mmm"), "{err}");
     // a toolpath with a malformed line: error names the CL file and line
@@ -159,8 +137,7 @@ fn bad_case_files_name_file_case_and_key() {
     )
     .unwrap();
     fs::write(&cfg, "[[case]]\nname = \"p\"\nteeth = 2\ndiameter_mm = 6\nrpm = 6000\nheights_mm = [0]\nmotion = \"path\"\ntoolpath = \"p.apt\"\n").unwrap();
-    let out = runout().args(["chip", "eval"]).arg(&cfg).output().unwrap();
-    assert!(!out.status.success());
+    let out = runout().args(["chip", "eval"]).arg(&cfg).failure_output();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("p.apt:4"), "{err}");
 }
@@ -186,13 +163,7 @@ fn simulate_with_every_chip_model() {
         let out = runout()
             .args(&base)
             .args(["--chip-model", model])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+            .success_output();
         let v = json_of(&out.stdout);
         assert_eq!(v["inputs"]["chip_model"], model);
         v["tooth_peaks"]
@@ -209,9 +180,7 @@ fn simulate_with_every_chip_model() {
     let out = runout()
         .args(&base)
         .args(["--chip-model", "trochoid"])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
+        .failure_output();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("chip_model") && err.contains("exact"), "{err}");
 }
@@ -222,13 +191,7 @@ fn compare_machine_without_rtcp() {
         .args(["chip", "compare"])
         .arg(chip_example("joints_no_rtcp.toml"))
         .args(["--json", "-"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let v = json_of(&out.stdout);
     let e = |m: &str| v["pooled"][m]["normalised_mae_percent"].as_f64().unwrap();
     // fast head rotations (C 90° over 10 mm): still a second-order model, far better than arc

@@ -116,3 +116,35 @@ pub fn plot_without_provenance(path: &std::path::Path) -> Vec<u8> {
     }
     out
 }
+
+/// Running a built `runout` command and checking how it ended (the `.output().unwrap()` +
+/// `assert!(out.status.success())` boilerplate of the tests), with the other stream in the
+/// failure message.
+pub trait Ran {
+    /// Run; assert it succeeded (its stderr in the message); its output.
+    fn success_output(&mut self) -> std::process::Output;
+    /// Run; assert it failed (its stdout in the message); its output.
+    fn failure_output(&mut self) -> std::process::Output;
+}
+
+impl Ran for Command {
+    fn success_output(&mut self) -> std::process::Output {
+        let out = self.output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out
+    }
+
+    fn failure_output(&mut self) -> std::process::Output {
+        let out = self.output().unwrap();
+        assert!(
+            !out.status.success(),
+            "succeeded: {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+        out
+    }
+}

@@ -14,12 +14,7 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 fn json_of(args: &[&str]) -> serde_json::Value {
-    let out = runout().args(args).args(["--json", "-"]).output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = runout().args(args).args(["--json", "-"]).success_output();
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -104,8 +99,7 @@ fn teeth_two_teeth_ambiguity_and_phase() {
         "{v}"
     );
     // without --offset-um K = 2 is an error that says what to give
-    let out = runout().args(&base[..9]).output().unwrap();
-    assert!(!out.status.success());
+    let out = runout().args(&base[..9]).failure_output();
     assert!(String::from_utf8_lossy(&out.stderr).contains("runout length"));
 }
 

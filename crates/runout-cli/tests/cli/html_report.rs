@@ -7,7 +7,7 @@
 //! error, the verdict and plots in the DOM, a screenshot) is the ignored test at the end.
 
 use crate::common;
-use common::{example, runout};
+use common::{example, runout, Ran};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -274,9 +274,7 @@ fn displacement_pages_and_the_comparison_of_saved_reports() {
     std::fs::write(&bad, "{\"schema\": \"runout.simulate/1\"}").unwrap();
     let out = runout()
         .args(["report", bad.to_str().unwrap(), "--html", "-"])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
+        .failure_output();
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(
         e.contains("x.json: schema `runout.simulate/1` has no HTML page"),

@@ -102,13 +102,7 @@ fn five_feeds_through_a_1100_hz_mode_auto_chain() {
         .args(&recs)
         .args(CUT)
         .args(["--fz-mm", &FEEDS.join(","), "--json", "-"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let decision = &v["measuring_chain"]["decision"];
     assert_eq!(decision["used"], "fitted_modes", "{decision}");

@@ -28,13 +28,7 @@ fn bundled_example_recovers_the_known_runout_and_coefficients() {
         .arg(identify_example("cut.toml"))
         .args(["--json", "-", "--plot-dir"])
         .arg(dir.path())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["schema"], "runout.identify.recording/2");
     let f = &v["full_signal"];
@@ -200,13 +194,7 @@ fn semicolon_decimal_comma_and_axis_mapping_with_signs() {
             "--json",
             "-",
         ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let f = &v["full_signal"];
     let rho = f["offset_um"].as_f64().unwrap();
@@ -351,13 +339,7 @@ fn straight_flutes_with_strong_edge_forces_are_aligned() {
             "--json",
             "-",
         ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let f = &v["full_signal"];
     let (rho, lam) = (
@@ -435,13 +417,7 @@ fn two_teeth_report_the_radius_difference() {
         .args(&recs)
         .args(common)
         .args(["--fz-mm", "0.06,0.1", "--json", "-"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     // truth at the tip: R₀ − R₁ = |R u₀ + e| − |R u₁ + e| ≈ 2ρ cos λ = 11.28 µm
     let truth = 2.0 * 6.0 * 20f64.to_radians().cos();

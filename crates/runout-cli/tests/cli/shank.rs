@@ -15,13 +15,7 @@ fn stiffness_json(args: &[&str]) -> serde_json::Value {
         .args(["shank", "stiffness"])
         .args(args)
         .args(["--json", "-"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -264,13 +258,7 @@ fn force_json(rec: &Path, cfg: &Path, extra: &[&str]) -> serde_json::Value {
         .arg(cfg)
         .args(extra)
         .args(["--json", "-"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -535,13 +523,7 @@ fn static_calibration_from_a_load_recording() {
             "--json",
             "-",
         ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let truth = held.stiffness_n_per_um();
     let (k_fit, se) = (
@@ -693,9 +675,7 @@ fn bending_mode_bandwidth_warning_and_correction() {
             .arg(&rec)
             .arg("--config")
             .arg(cfg(name, dynamics))
-            .output()
-            .unwrap();
-        assert!(!out.status.success());
+            .failure_output();
         String::from_utf8_lossy(&out.stderr).to_string()
     };
     let e = bad(

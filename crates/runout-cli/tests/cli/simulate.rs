@@ -11,13 +11,7 @@ fn flags_alone_give_reference_peak_in_json() {
         .args(SEED003_CUT)
         .args(SEED003_COEFFICIENTS)
         .args(["--step-deg", "0.01", "--revolutions", "1", "--json", "-"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["schema"], "runout.simulate/1");
     let peaks = v["tooth_peaks"].as_array().unwrap();
@@ -75,13 +69,7 @@ fn flags_override_the_file_and_accept_unit_suffixes() {
             "--json",
             "-",
         ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!((v["inputs"]["runout_um"].as_f64().unwrap() - 12.0).abs() < 1e-9);
 }
@@ -154,13 +142,11 @@ fn refuses_to_overwrite_the_config() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("case.toml");
     fs::write(&p, GOOD).unwrap();
-    let out = runout()
+    runout()
         .arg("simulate")
         .arg(&p)
         .arg("--out")
         .arg(&p)
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
+        .failure_output();
     assert_eq!(fs::read_to_string(&p).unwrap(), GOOD);
 }

@@ -58,7 +58,7 @@ fn record(dir: &Path, name: &str, extra: &[&str]) -> (Vec<f64>, Vec<f64>, String
     let path = dir.join(name);
     let json = dir.join(format!("{name}.json"));
     let csv = dir.join(format!("{name}.csv"));
-    let out = runout()
+    runout()
         .args(CASE)
         .args(["--sample-rate-hz", "12000", "--recording"])
         .arg(&path)
@@ -67,13 +67,7 @@ fn record(dir: &Path, name: &str, extra: &[&str]) -> (Vec<f64>, Vec<f64>, String
         .arg("--out")
         .arg(&csv)
         .args(extra)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .success_output();
     let text = std::fs::read_to_string(&path).unwrap();
     let (mut fx, mut fy, mut header) = (Vec::new(), Vec::new(), String::new());
     for line in text.lines() {
@@ -323,8 +317,6 @@ fn bad_sensor_values_name_the_flag() {
     let out = runout()
         .args(CASE)
         .args(["--sensor-mode-hz", "1100"])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
+        .failure_output();
     assert!(String::from_utf8_lossy(&out.stderr).contains("give --recording"));
 }
