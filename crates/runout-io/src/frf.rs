@@ -33,7 +33,7 @@ pub fn read_frf(path: &Path) -> Result<MeasuringChain, FrfError> {
 }
 
 /// Parse the text of an FRF table; `file` names it in errors. Read with the shared table
-/// reader ([`crate::table`], fields separated by commas, semicolons, tabs or spaces).
+/// reader (`runout_io::table`, fields separated by commas, semicolons, tabs or spaces).
 pub fn parse_frf(file: &str, text: &str) -> Result<MeasuringChain, FrfError> {
     let err = |line: usize, message: String| FrfError::new(file, line, message);
     if text

@@ -162,7 +162,7 @@ pub fn parse_toml(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
 }
 
 /// Parse a CSV/TSV peak table (see module docs for the columns) with the shared table reader
-/// ([`crate::table`]: separator from the header row, decimal commas with `;` or tab).
+/// (`runout_io::table`: separator from the header row, decimal commas with `;` or tab).
 pub fn parse_csv(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
     let t = crate::table::parse_text(file, text, false)?;
     let hl = t.header_line;

@@ -1,4 +1,4 @@
-//! The grind tables (probe points, edge lines) on the shared table reader ([`crate::table`]):
+//! The grind tables (probe points, edge lines) on the shared table reader (`runout_io::table`):
 //! only the known columns are accepted, every value is a finite number, and every error is the
 //! shared [`LocatedError`] naming the file, the line and the column.
 
