@@ -32,39 +32,37 @@ pub fn read_frf(path: &Path) -> Result<MeasuringChain, FrfError> {
     parse_frf(&file, &text)
 }
 
-fn split(line: &str) -> Vec<&str> {
-    line.split(|c: char| c == ',' || c == ';' || c == '\t' || c.is_whitespace())
-        .filter(|s| !s.is_empty())
-        .collect()
-}
-
-/// Parse the text of an FRF table; `file` names it in errors.
+/// Parse the text of an FRF table; `file` names it in errors. Read with the shared table
+/// reader (`runout_io::table`, fields separated by commas, semicolons, tabs or spaces).
 pub fn parse_frf(file: &str, text: &str) -> Result<MeasuringChain, FrfError> {
     let err = |line: usize, message: String| FrfError::new(file, line, message);
-    let mut lines = text
+    if text
         .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, header) = lines.next().ok_or_else(|| {
-        err(
+        .all(|l| l.trim().is_empty() || l.trim_start().starts_with('#'))
+    {
+        return Err(err(
             0,
             "empty: expected a header `freq_Hz, xx_re, xx_im, yy_re, yy_im` and rows".into(),
-        )
-    })?;
-    let names: Vec<String> = split(header).iter().map(|s| s.to_lowercase()).collect();
-    let col = |n: &str| names.iter().position(|h| h == n);
-    let freq = col("freq_hz")
-        .or_else(|| col("frequency_hz"))
+        ));
+    }
+    let t = crate::table::parse_text(file, text, true)?;
+    let hline = t.header_line;
+    let header = t.headers.join(", ");
+    let freq = t
+        .column("freq_hz")
+        .or_else(|| t.column("frequency_hz"))
         .ok_or_else(|| {
             err(
                 hline,
                 format!("header `{header}` has no `freq_Hz` column (expected freq_Hz, xx_re, xx_im, yy_re, yy_im[, zz_re, zz_im])"),
             )
         })?;
-    let mut axes: Vec<(usize, usize, usize)> = Vec::new(); // (axis, re col, im col)
+    let mut axes = Vec::new(); // (axis, re column, im column)
     for (a, name) in ["xx", "yy", "zz"].iter().enumerate() {
-        match (col(&format!("{name}_re")), col(&format!("{name}_im"))) {
+        match (
+            t.column(&format!("{name}_re")),
+            t.column(&format!("{name}_im")),
+        ) {
             (Some(r), Some(i)) => axes.push((a, r, i)),
             (None, None) => {}
             _ => {
@@ -81,37 +79,11 @@ pub fn parse_frf(file: &str, text: &str) -> Result<MeasuringChain, FrfError> {
             format!("header `{header}` has no response columns (xx_re, xx_im, yy_re, yy_im)"),
         ));
     }
-    let mut f = Vec::new();
+    let mut f: Vec<f64> = Vec::new();
     let mut v: Vec<Vec<Complex64>> = vec![Vec::new(); 3];
-    let mut rows = Vec::new();
-    for (ln, line) in lines {
-        let cells = split(line);
-        if cells.len() != names.len() {
-            return Err(err(
-                ln,
-                format!(
-                    "{} fields, expected {} as in the header",
-                    cells.len(),
-                    names.len()
-                ),
-            ));
-        }
-        let num = |c: usize| {
-            cells[c]
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| {
-                    err(
-                        ln,
-                        format!(
-                            "`{}` in column `{}` is not a finite number",
-                            cells[c], names[c]
-                        ),
-                    )
-                })
-        };
-        let fv = num(freq)?;
+    let rows: Vec<usize> = t.rows.iter().map(|r| r.0).collect();
+    for (r, &ln) in rows.iter().enumerate() {
+        let fv = t.number(r, &freq)?;
         if let Some(&prev) = f.last() {
             if fv <= prev {
                 return Err(err(
@@ -123,13 +95,13 @@ pub fn parse_frf(file: &str, text: &str) -> Result<MeasuringChain, FrfError> {
             return Err(err(ln, format!("frequency {fv} Hz: expected ≥ 0 Hz")));
         }
         f.push(fv);
-        for &(a, r, i) in &axes {
-            v[a].push(Complex64::new(num(r)?, num(i)?));
+        for (a, re, im) in &axes {
+            v[*a].push(Complex64::new(t.number(r, re)?, t.number(r, im)?));
         }
-        rows.push(ln);
     }
+    let axes: Vec<usize> = axes.iter().map(|x| x.0).collect();
     let mut chain = MeasuringChain::default();
-    for &(a, _, _) in &axes {
+    for &a in &axes {
         let name = format!("{file} {}", ["xx", "yy", "zz"][a]);
         let curve = FrfCurve::new(&name, f.clone(), std::mem::take(&mut v[a]))
             .map_err(|e| err(if rows.is_empty() { hline } else { rows[0] }, e.to_string()))?;
@@ -168,7 +140,7 @@ mod tests {
         assert!(e.to_string().starts_with("t.csv:3: 2 fields"), "{e}");
         let e = parse_frf("t.csv", "freq_Hz,xx_re,xx_im\n0,1,0\n1,1,x\n").unwrap_err();
         assert!(
-            e.to_string().contains("t.csv:3: `x` in column `xx_im`"),
+            e.to_string().contains("t.csv:3:3: `x` in column `xx_im`"),
             "{e}"
         );
         let e = parse_frf("t.csv", "freq_Hz,xx_re,xx_im\n10,1,0\n5,1,0\n").unwrap_err();
@@ -180,6 +152,8 @@ mod tests {
         );
         let e = parse_frf("t.csv", "freq_Hz,xx_re\n").unwrap_err();
         assert!(e.message.contains("xx_im"), "{e}");
+        let e = parse_frf("t.csv", "freq_Hz xx_re  xx_im\n0 1 0\n1 1 x\n").unwrap_err();
+        assert!(e.to_string().starts_with("t.csv:3:3: `x`"), "{e}");
         let e = parse_frf("t.csv", "freq_Hz,xx_re,xx_im\n0,0,0\n1,1,0\n").unwrap_err();
         assert!(e.message.contains("non-zero static"), "{e}");
     }

@@ -19,6 +19,7 @@ pub mod peak_table;
 pub mod plot;
 pub mod recording;
 pub mod report;
+pub(crate) mod table;
 pub mod textfile;
 pub mod toolpath;
 pub mod units;

@@ -161,63 +161,37 @@ pub fn parse_toml(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
     })
 }
 
-fn delimiter(text: &str) -> u8 {
-    let header = text
-        .lines()
-        .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
-        .unwrap_or("");
-    [b'\t', b';', b',']
-        .into_iter()
-        .max_by_key(|d| header.bytes().filter(|b| b == d).count())
-        .unwrap_or(b',')
-}
-
-/// Parse a CSV/TSV peak table (see module docs for the columns).
+/// Parse a CSV/TSV peak table (see module docs for the columns) with the shared table reader
+/// (`runout_io::table`: separator from the header row, decimal commas with `;` or tab).
 pub fn parse_csv(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
-    let err = |line: usize, column: Option<usize>, message: String| PeakTableError {
-        file: file.into(),
-        line,
-        column,
-        message,
-    };
-    let mut rdr = csv::ReaderBuilder::new()
-        .delimiter(delimiter(text))
-        .comment(Some(b'#'))
-        .trim(csv::Trim::All)
-        .flexible(false)
-        .from_reader(text.as_bytes());
-    let headers = rdr
-        .headers()
-        .map_err(|e| err(1, None, format!("cannot read the header row: {e}")))?
-        .clone();
-    let col = |name: &str| headers.iter().position(|h| h.eq_ignore_ascii_case(name));
+    let t = crate::table::parse_text(file, text, false)?;
+    let hl = t.header_line;
     let need = |name: &str| {
-        col(name).ok_or_else(|| {
-            err(
-                1,
-                None,
-                format!(
-                    "no column `{name}` (columns: {})",
-                    headers.iter().collect::<Vec<_>>().join(", ")
-                ),
+        t.column(name).ok_or_else(|| {
+            PeakTableError::new(
+                file,
+                hl,
+                format!("no column `{name}` (columns: {})", t.headers.join(", ")),
             )
         })
     };
     let c_fz = need("fz_mm")?;
     let c_ap = need("ap_mm")?;
-    let peak_cols: Vec<usize> = (0..).map_while(|i| col(&format!("peak{i}_N"))).collect();
+    let peak_cols: Vec<_> = (0..)
+        .map_while(|i| t.column(&format!("peak{i}_N")))
+        .collect();
     if peak_cols.len() < 2 {
-        return Err(err(
-            1,
-            None,
-            "expected per-tooth peak columns `peak0_N`, `peak1_N`, … (at least 2)".into(),
+        return Err(PeakTableError::new(
+            file,
+            hl,
+            "expected per-tooth peak columns `peak0_N`, `peak1_N`, … (at least 2)",
         ));
     }
-    let se_cols: Vec<usize> = (0..).map_while(|i| col(&format!("se{i}_N"))).collect();
+    let se_cols: Vec<_> = (0..).map_while(|i| t.column(&format!("se{i}_N"))).collect();
     if !se_cols.is_empty() && se_cols.len() != peak_cols.len() {
-        return Err(err(
-            1,
-            None,
+        return Err(PeakTableError::new(
+            file,
+            hl,
             format!(
                 "{} standard-error columns se*_N for {} peak columns",
                 se_cols.len(),
@@ -225,77 +199,44 @@ pub fn parse_csv(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
             ),
         ));
     }
-    let c_label = col("test").or_else(|| col("label"));
-    let (c_fx, c_fy) = (col("fx_at_peak_N"), col("fy_at_peak_N"));
-    let (c_d, c_ae, c_mode) = (col("diameter_mm"), col("ae_mm"), col("mode"));
-    let mut rows = Vec::new();
-    for (i, rec) in rdr.records().enumerate() {
-        let rec = rec.map_err(|e| {
-            let line = e.position().map(|p| p.line() as usize).unwrap_or(0);
-            err(line, None, e.to_string())
-        })?;
-        let line = rec.position().map(|p| p.line() as usize).unwrap_or(i + 2);
-        let num = |c: usize| -> Result<f64, PeakTableError> {
-            let t = rec.get(c).unwrap_or("");
-            let v: f64 = t.replace(',', ".").parse().map_err(|_| {
-                err(
-                    line,
-                    Some(c + 1),
-                    format!(
-                        "`{}` in column `{}` is not a number",
-                        crate::textfile::quote(t),
-                        &headers[c]
-                    ),
-                )
-            })?;
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(err(
-                    line,
-                    Some(c + 1),
-                    format!(
-                        "`{}` in column `{}` is not finite",
-                        crate::textfile::quote(t),
-                        &headers[c]
-                    ),
-                ))
-            }
-        };
-        let opt = |c: Option<usize>| -> Result<Option<f64>, PeakTableError> {
-            match c {
-                Some(c) if !rec.get(c).unwrap_or("").is_empty() => num(c).map(Some),
-                _ => Ok(None),
-            }
-        };
-        let text_opt = |c: Option<usize>| {
-            c.and_then(|c| rec.get(c))
-                .filter(|t| !t.is_empty())
+    let c_label = t.column("test").or_else(|| t.column("label"));
+    let (c_fx, c_fy) = (t.column("fx_at_peak_N"), t.column("fy_at_peak_N"));
+    let (c_d, c_ae, c_mode) = (t.column("diameter_mm"), t.column("ae_mm"), t.column("mode"));
+    if t.rows.is_empty() {
+        return Err(PeakTableError::new(
+            file,
+            0,
+            "no test rows after the header",
+        ));
+    }
+    let mut rows = Vec::with_capacity(t.rows.len());
+    for r in 0..t.rows.len() {
+        let text_opt = |c: &Option<crate::table::Column>| {
+            c.as_ref()
+                .map(|c| t.text(r, c))
+                .filter(|s| !s.is_empty())
                 .map(String::from)
         };
+        let all = |cols: &[crate::table::Column]| -> Result<Vec<f64>, PeakTableError> {
+            cols.iter().map(|c| t.number(r, c)).collect()
+        };
         rows.push(PeakRow {
-            label: text_opt(c_label).unwrap_or_else(|| format!("{}", i + 1)),
-            fz_mm: num(c_fz)?,
-            ap_mm: num(c_ap)?,
-            peaks_n: peak_cols
-                .iter()
-                .map(|&c| num(c))
-                .collect::<Result<_, _>>()?,
+            label: text_opt(&c_label).unwrap_or_else(|| format!("{}", r + 1)),
+            fz_mm: t.number(r, &c_fz)?,
+            ap_mm: t.number(r, &c_ap)?,
+            peaks_n: all(&peak_cols)?,
             peaks_se_n: if se_cols.is_empty() {
                 None
             } else {
-                Some(se_cols.iter().map(|&c| num(c)).collect::<Result<_, _>>()?)
+                Some(all(&se_cols)?)
             },
-            fx_at_peak_n: opt(c_fx)?,
-            fy_at_peak_n: opt(c_fy)?,
-            diameter_mm: opt(c_d)?,
-            ae_mm: opt(c_ae)?,
-            mode: text_opt(c_mode),
-            line,
+            fx_at_peak_n: t.optional(r, c_fx.as_ref())?,
+            fy_at_peak_n: t.optional(r, c_fy.as_ref())?,
+            diameter_mm: t.optional(r, c_d.as_ref())?,
+            ae_mm: t.optional(r, c_ae.as_ref())?,
+            mode: text_opt(&c_mode),
+            line: t.rows[r].0,
         });
-    }
-    if rows.is_empty() {
-        return Err(err(0, None, "no test rows after the header".into()));
     }
     Ok(PeakTable {
         settings: TableSettings {

@@ -9,11 +9,11 @@ mod example;
 #[allow(dead_code)]
 mod identify_example;
 
-/// The JSON body of the CLI snapshot `name` (crates/runout-cli/tests/snapshots).
+/// The JSON body of the CLI snapshot `name` (crates/runout-cli/tests/cli/snapshots).
 fn cli_json(name: &str) -> serde_json::Value {
     let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../runout-cli/tests/snapshots")
-        .join(format!("snapshots__{name}.snap"));
+        .join("../runout-cli/tests/cli/snapshots")
+        .join(format!("cli__snapshots__{name}.snap"));
     let text = std::fs::read_to_string(&p).unwrap();
     let rest = text.strip_prefix("---").unwrap();
     serde_json::from_str(&rest[rest.find("\n---\n").unwrap() + 5..]).unwrap()

@@ -1,6 +1,6 @@
 //! docs/schema/*.json are what schemars generates from the report types (regenerate with
 //! `RUNOUT_UPDATE_SCHEMAS=1 cargo test -p runout --test schemas`), and every JSON output of the
-//! CLI snapshot tests (crates/runout-cli/tests/snapshots, the CLI's stdout byte for byte)
+//! CLI snapshot tests (crates/runout-cli/tests/cli/snapshots, the CLI's stdout byte for byte)
 //! validates against the schema its `schema` field names.
 
 use std::collections::BTreeMap;
@@ -77,7 +77,7 @@ fn cli_outputs_validate_against_their_schemas() {
             (id, jsonschema::validator_for(&s).unwrap())
         })
         .collect();
-    let dir = root().join("crates/runout-cli/tests/snapshots");
+    let dir = root().join("crates/runout-cli/tests/cli/snapshots");
     let mut checked = BTreeMap::<String, usize>::new();
     for e in std::fs::read_dir(&dir).unwrap() {
         let p = e.unwrap().path();
@@ -114,7 +114,7 @@ fn a_wrong_output_is_refused() {
     let s: serde_json::Value = serde_json::from_str(&text).unwrap();
     let v = jsonschema::validator_for(&s).unwrap();
     let body = std::fs::read_to_string(
-        root().join("crates/runout-cli/tests/snapshots/snapshots__shank_stiffness.snap"),
+        root().join("crates/runout-cli/tests/cli/snapshots/cli__snapshots__shank_stiffness.snap"),
     )
     .unwrap();
     let mut good: serde_json::Value = serde_json::from_str(snapshot_body(&body)).unwrap();
@@ -139,7 +139,7 @@ fn the_batch_snapshot_needs_its_wall_clock_numbers() {
     let s: serde_json::Value = serde_json::from_str(&text).unwrap();
     let v = jsonschema::validator_for(&s).unwrap();
     let body = std::fs::read_to_string(
-        root().join("crates/runout-cli/tests/snapshots/batch_snapshot__batch.snap"),
+        root().join("crates/runout-cli/tests/cli/snapshots/cli__batch_snapshot__batch.snap"),
     )
     .unwrap();
     let mut report: serde_json::Value = serde_json::from_str(snapshot_body(&body)).unwrap();

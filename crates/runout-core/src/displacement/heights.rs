@@ -10,6 +10,7 @@
 
 use super::error::{check_finite, DisplacementError};
 use super::estimate::{polar_with_covariance, AngleEstimate};
+use crate::fit::{fit_offset_tilt, LineNoise, OffsetTiltFit};
 use crate::runout::Runout;
 use nalgebra::Matrix2;
 use serde::Serialize;
@@ -149,36 +150,32 @@ pub fn runout_at_height(
     })
 }
 
-/// Result of [`vector_at_height`]: offset and tilt vectors (spindle frame).
+/// Result of [`vector_at_height`]: the offset + tilt line and the runout at the height z_c.
 #[derive(Debug, Clone, Serialize)]
 pub struct VectorHeightFit {
     /// Height z_c (mm) of the reported runout.
     pub height_mm: f64,
-    /// E₀ (mm): the runout vector at z = 0.
-    pub offset_at_zero_mm: [f64; 2],
-    /// T (mm/mm): the tilt vector.
-    pub tilt: [f64; 2],
+    /// The line E(z) = E₀ + z·T (spindle frame; E₀ in mm at z = 0, T in mm/mm), with standard
+    /// errors from the residual scatter pooled over both components (`None` with two heights).
+    pub line: OffsetTiltFit,
     /// ρ(z_c) (mm).
     pub offset_mm: f64,
     /// Standard error of ρ(z_c) (mm), with more than two heights.
     pub offset_se_mm: Option<f64>,
     /// λ(z_c) or why it is undetermined.
     pub angle: AngleEstimate,
-    /// RMS of the vector residuals |E_i − E₀ − z_i·T| (mm).
-    pub residual_rms_mm: f64,
-    /// Number of heights.
-    pub points: usize,
 }
 
 impl VectorHeightFit {
     /// The runout e(z) = E₀ + z·T as a [`Runout`] (z = 0 reference).
     pub fn runout(&self) -> Runout {
-        Runout::from_vector(self.offset_at_zero_mm).with_tilt_vector(self.tilt)
+        self.line.runout()
     }
 }
 
 /// Complex line E(z) = E₀ + z·T through first-harmonic vectors E_i = (x, y) (mm, spindle frame)
-/// at heights z_i, by linear least squares (methods.md §1.6); evaluated at `z_c_mm`.
+/// at heights z_i, by linear least squares ([`fit_offset_tilt`], methods.md §1.6); evaluated at
+/// `z_c_mm`, with σ² = Σ|E_i − E(z_i)|²/(2n − 4) for both components.
 ///
 /// ```
 /// use runout_core::displacement::vector_at_height;
@@ -195,43 +192,21 @@ pub fn vector_at_height(
     check_heights(&z, "heights for the vector regression", n)?;
     let flat: Vec<f64> = points.iter().flat_map(|p| p.1).collect();
     check_finite("runout vector component", &flat)?;
-    let nf = n as f64;
-    let zbar = z.iter().sum::<f64>() / nf;
-    let szz: f64 = z.iter().map(|v| (v - zbar).powi(2)).sum();
-    let mut e0 = [0.0; 2];
-    let mut t = [0.0; 2];
-    let mut rss = 0.0;
-    for c in 0..2 {
-        let ebar = points.iter().map(|p| p.1[c]).sum::<f64>() / nf;
-        let sze: f64 = points.iter().map(|p| (p.0 - zbar) * (p.1[c] - ebar)).sum();
-        t[c] = sze / szz;
-        e0[c] = ebar - t[c] * zbar;
-        rss += points
-            .iter()
-            .map(|p| (p.1[c] - e0[c] - t[c] * p.0).powi(2))
-            .sum::<f64>();
-    }
-    let at = [e0[0] + z_c_mm * t[0], e0[1] + z_c_mm * t[1]];
-    let dof = 2 * n - 4;
-    let var_at = (dof > 0).then(|| {
-        let s2 = rss / dof as f64;
-        s2 * (1.0 / nf + (z_c_mm - zbar).powi(2) / szz)
-    });
-    let (rho, lambda, se_rho, se_l) = match var_at {
+    let line = fit_offset_tilt(points, &LineNoise::Pooled)
+        .map_err(|e| DisplacementError::Fit(e.to_string()))?;
+    let at = line.at(z_c_mm);
+    let (rho, lambda, se_rho, se_l) = match line.at_variance(z_c_mm) {
         Some(v) => {
-            let (r, l, sr, sl) = polar_with_covariance(at, &Matrix2::new(v, 0.0, 0.0, v));
+            let (r, l, sr, sl) = polar_with_covariance(at, &Matrix2::new(v[0], 0.0, 0.0, v[1]));
             (r, l, Some(sr), Some(sl))
         }
         None => (at[0].hypot(at[1]), at[1].atan2(at[0]), None, None),
     };
     Ok(VectorHeightFit {
         height_mm: z_c_mm,
-        offset_at_zero_mm: e0,
-        tilt: t,
+        line,
         offset_mm: rho,
         offset_se_mm: se_rho,
         angle: AngleEstimate::checked(lambda, se_l, rho),
-        residual_rms_mm: (rss / nf).sqrt(),
-        points: n,
     })
 }

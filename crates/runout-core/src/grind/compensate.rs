@@ -1,10 +1,10 @@
 //! Wheel-path compensation w′_k = w_k + ε_k·N_k (methods.md §5.4) with the predicted remaining
 //! error of each point.
 
-use super::deviation::AxisFit;
 use super::edge::EdgeLine;
 use super::interp::{Interpolator, RangePolicy, Scheme};
 use crate::error::ParamError;
+use crate::fit::OffsetTiltFit;
 
 /// One compensated point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -23,7 +23,7 @@ pub struct CompensatedPoint {
     /// bar axis: −e(u_k)·n_k (mm; > 0 = edge too far from the real axis), first order.
     pub before: f64,
     /// Predicted remaining radial error with compensation: ε_k − e(u_k)·n_k (mm), where e is the
-    /// fitted rigid axis ([`AxisFit`]): the part of ε that a rigid offset + tilt does not explain
+    /// fitted rigid axis ([`super::DeviationMap::axis`]): the part of ε that a rigid offset + tilt does not explain
     /// (interpolation error, noise, form error).
     pub remaining: f64,
 }
@@ -88,7 +88,7 @@ pub fn rms_max(v: impl Iterator<Item = f64>) -> (f64, f64) {
 /// ```
 pub fn compensate(
     interp: &Interpolator,
-    axis: &AxisFit,
+    axis: &OffsetTiltFit,
     edge: &EdgeLine,
     wheel: Option<&[[f64; 3]]>,
 ) -> Result<Compensation, ParamError> {

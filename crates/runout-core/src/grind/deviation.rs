@@ -2,7 +2,7 @@
 //! bar axis (offset + tilt) and the residual form error (methods.md §5.2, §5.5).
 
 use super::probe::{Layer, ProbeGrid};
-use crate::fit::LinearLsq;
+use crate::fit::{fit_offset_tilt, LineNoise, LinearLsq, OffsetTiltFit};
 use nalgebra::{DMatrix, DVector};
 
 /// Deviations of one layer.
@@ -31,41 +31,16 @@ pub struct LayerDeviation {
     pub condition: f64,
 }
 
-/// Least-squares line through the per-layer first harmonics: e(u) = e₀ + u·τ, with
-/// (c_i, s_i) ≈ e(u_i) because R_ij ≈ R + e(u_i)·(cos α_j, sin α_j) (methods.md §5.2).
-#[derive(Debug, Clone, PartialEq)]
-pub struct AxisFit {
-    /// Offset e₀ of the bar axis at u = 0 (mm, bar frame x, y).
-    pub offset: [f64; 2],
-    /// Tilt τ (mm per mm of u).
-    pub tilt: [f64; 2],
-    /// Standard errors of the offset components (mm); `None` with only 2 layers.
-    pub offset_se: Option<[f64; 2]>,
-    /// Standard errors of the tilt components (mm/mm); `None` with only 2 layers.
-    pub tilt_se: Option<[f64; 2]>,
-    /// Per-layer residual (c_i, s_i) − e(u_i) (mm): what a rigid offset + tilt does not explain.
-    pub layer_residual: Vec<[f64; 2]>,
-    /// RMS of |layer_residual| (mm).
-    pub residual_rms: f64,
-}
-
-impl AxisFit {
-    /// e(u) = e₀ + u·τ (mm).
-    pub fn at(&self, u: f64) -> [f64; 2] {
-        [
-            self.offset[0] + u * self.tilt[0],
-            self.offset[1] + u * self.tilt[1],
-        ]
-    }
-}
-
 /// The deviation map of a probe grid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DeviationMap {
     /// Per-layer deviations, in increasing u.
     pub layers: Vec<LayerDeviation>,
-    /// Fitted bar axis.
-    pub axis: AxisFit,
+    /// Fitted bar axis: the least-squares line e(u) = e₀ + u·τ through the per-layer first
+    /// harmonics, (c_i, s_i) ≈ e(u_i) because R_ij ≈ R + e(u_i)·(cos α_j, sin α_j) (methods.md §5.2);
+    /// standard errors from the residual scatter of each component (`None` with only 2 layers);
+    /// `residuals` are the per-layer (c_i, s_i) − e(u_i).
+    pub axis: OffsetTiltFit,
 }
 
 impl DeviationMap {
@@ -79,7 +54,7 @@ impl DeviationMap {
     /// let r: Vec<Vec<f64>> = u.iter().map(|_| alpha.iter().map(|a| 3.0 + 0.01 * a.cos()).collect()).collect();
     /// let grid = ProbeGrid::from_radii(&u, &alpha, &r, Generatrix::cylinder(3.0).unwrap()).unwrap();
     /// let map = DeviationMap::new(&grid);
-    /// assert!((map.axis.offset[0] - 0.01).abs() < 1e-12 && map.axis.tilt[0].abs() < 1e-12);
+    /// assert!((map.axis.offset[0].value - 0.01).abs() < 1e-12 && map.axis.tilt[0].value.abs() < 1e-12);
     /// ```
     pub fn new(grid: &ProbeGrid) -> Self {
         let layers: Vec<LayerDeviation> = grid.layers.iter().map(layer_deviation).collect();
@@ -139,49 +114,10 @@ fn layer_deviation(l: &Layer) -> LayerDeviation {
     }
 }
 
-/// Least squares of (c_i, s_i) on [1, u_i].
-fn fit_axis(layers: &[LayerDeviation]) -> AxisFit {
-    let m = layers.len();
-    let lsq = LinearLsq::new(DMatrix::from_fn(m, 2, |i, k| {
-        if k == 0 {
-            1.0
-        } else {
-            layers[i].u
-        }
-    }));
-    let mut coef = [[0.0; 2]; 2]; // [component][intercept, slope]
-    let mut resid = vec![[0.0; 2]; m];
-    let mut rss = [0.0; 2];
-    let ata_inv = lsq.normal_inverse();
-    for comp in 0..2 {
-        let b = DVector::from_iterator(m, layers.iter().map(|l| if comp == 0 { l.c } else { l.s }));
-        let x = lsq
-            .beta(&b, 1e-14)
-            .unwrap_or_else(|_| DVector::from_element(2, f64::NAN));
-        coef[comp] = [x[0], x[1]];
-        let r = &b - lsq.design() * &x;
-        for i in 0..m {
-            resid[i][comp] = r[i];
-        }
-        rss[comp] = r.norm_squared();
-    }
-    let (offset_se, tilt_se) = match (m > 2, ata_inv) {
-        (true, Some(inv)) => {
-            let var = |c: usize| rss[c] / (m - 2) as f64;
-            (
-                Some([(var(0) * inv[(0, 0)]).sqrt(), (var(1) * inv[(0, 0)]).sqrt()]),
-                Some([(var(0) * inv[(1, 1)]).sqrt(), (var(1) * inv[(1, 1)]).sqrt()]),
-            )
-        }
-        _ => (None, None),
-    };
-    let residual_rms = ((rss[0] + rss[1]) / m as f64).sqrt();
-    AxisFit {
-        offset: [coef[0][0], coef[1][0]],
-        tilt: [coef[0][1], coef[1][1]],
-        offset_se,
-        tilt_se,
-        layer_residual: resid,
-        residual_rms,
-    }
+/// Least squares of (c_i, s_i) on [1, u_i] ([`fit_offset_tilt`]); a grid is built with ≥ 2
+/// layers, a hand-made one with fewer gets an undetermined (`NaN`) axis.
+fn fit_axis(layers: &[LayerDeviation]) -> OffsetTiltFit {
+    let points: Vec<(f64, [f64; 2])> = layers.iter().map(|l| (l.u, [l.c, l.s])).collect();
+    fit_offset_tilt(&points, &LineNoise::PerComponent)
+        .unwrap_or_else(|_| OffsetTiltFit::undetermined(layers.len()))
 }

@@ -20,7 +20,7 @@ mod probe;
 mod simulate;
 
 pub use compensate::{compensate, rms_max, CompensatedPoint, Compensation};
-pub use deviation::{AxisFit, DeviationMap, LayerDeviation};
+pub use deviation::{DeviationMap, LayerDeviation};
 pub use edge::{EdgeKind, EdgeLine, EdgePoint};
 pub use error::GrindError;
 pub use interp::{Interpolated, Interpolator, RangePolicy, Scheme};

@@ -356,7 +356,7 @@ fn vector_height_fit_recovers_offset_and_tilt() {
     let e = truth.vector_at(2.0);
     assert!((fit.offset_mm - e[0].hypot(e[1])).abs() < 1e-12);
     assert!((fit.angle.angle().unwrap() - e[1].atan2(e[0])).abs() < 1e-9);
-    assert!((fit.tilt[0] - truth.tilt()[0]).abs() < 1e-12);
+    assert!((fit.line.tilt[0].value - truth.tilt()[0]).abs() < 1e-12);
     // the magnitude-only OLS is visibly wrong here (|e(z)| is not a line)
     let mag: Vec<(f64, f64)> = pts.iter().map(|(z, v)| (*z, v[0].hypot(v[1]))).collect();
     let ols = runout_at_height(&mag, 2.0, HeightRegression::Ols).unwrap();
@@ -777,8 +777,9 @@ proptest! {
             (z, truth.vector_at(z))
         }).collect();
         let f = vector_at_height(&pts, 0.0).unwrap();
-        prop_assert!((f.offset_at_zero_mm[0] - e0x).abs() < 1e-12 && (f.offset_at_zero_mm[1] - e0y).abs() < 1e-12);
-        prop_assert!((f.tilt[0] - tx).abs() < 1e-12 && (f.tilt[1] - ty).abs() < 1e-12);
+        let ([ox, oy], [fx, fy]) = (f.line.offset_mm(), f.line.tilt_vector());
+        prop_assert!((ox - e0x).abs() < 1e-12 && (oy - e0y).abs() < 1e-12);
+        prop_assert!((fx - tx).abs() < 1e-12 && (fy - ty).abs() < 1e-12);
     }
 
     /// OLS on noise-free lines is exact at any evaluation height (1e-12 mm).

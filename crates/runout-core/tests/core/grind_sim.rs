@@ -107,20 +107,20 @@ fn axis_fit_recovers_offset_and_tilt_with_noise() {
     let normal = Normal::new(0.0, sigma).unwrap();
     let map = DeviationMap::new(&bar.probe(&u, &a, || normal.sample(&mut rng)).unwrap());
     let ax = &map.axis;
-    let (ose, tse) = (ax.offset_se.unwrap(), ax.tilt_se.unwrap());
+    let (ose, tse) = (ax.offset_se().unwrap(), ax.tilt_se().unwrap());
     let ubar = u.iter().sum::<f64>() / u.len() as f64;
     let suu: f64 = u.iter().map(|x| (x - ubar).powi(2)).sum();
     let sc = sigma * (2.0 / 12.0f64).sqrt();
     let (o_th, t_th) = (sc * (1.0 / 6.0 + ubar * ubar / suu).sqrt(), sc / suu.sqrt());
     for k in 0..2 {
         assert!(
-            (ax.offset[k] - bar.offset[k]).abs() <= 4.0 * ose[k],
+            (ax.offset[k].value - bar.offset[k]).abs() <= 4.0 * ose[k],
             "offset[{k}] {} vs {} ± {}",
-            ax.offset[k],
+            ax.offset[k].value,
             bar.offset[k],
             ose[k]
         );
-        assert!((ax.tilt[k] - bar.tilt[k]).abs() <= 4.0 * tse[k]);
+        assert!((ax.tilt[k].value - bar.tilt[k]).abs() <= 4.0 * tse[k]);
         // SE estimated from 4 degrees of freedom: within a factor 0.4–1.8 of the truth (95 %)
         assert!(
             ose[k] > 0.3 * o_th && ose[k] < 2.0 * o_th,
@@ -241,8 +241,8 @@ proptest! {
         let (u, a) = uniform_grid(1.0, 25.0, m, c).unwrap();
         let map = DeviationMap::new(&bar.probe(&u, &a, || 0.0).unwrap());
         for k in 0..2 {
-            prop_assert!((map.axis.offset[k] - bar.offset[k]).abs() < 1e-8);
-            prop_assert!((map.axis.tilt[k] - bar.tilt[k]).abs() < 1e-9);
+            prop_assert!((map.axis.offset[k].value - bar.offset[k]).abs() < 1e-8);
+            prop_assert!((map.axis.tilt[k].value - bar.tilt[k]).abs() < 1e-9);
         }
         let edge = EdgeLine::helical_flat(6.0, 3, 35.0, 1.0, 25.0, 60).unwrap();
         let f = Interpolator::new(&map, Scheme::FirstHarmonic, RangePolicy::Clamp);

@@ -327,8 +327,8 @@ fn round_trip_force_and_runout_over_300_revolutions() {
         eprintln!(
             "pulse {pulse}: relative RMS force error x {ex:.5} y {ey:.5}; f error {:.2e}; tip offset error {:.3} µm; tilt error {:.4} µm/mm",
             f / syn.f_true - 1.0,
-            (analysis.runout.tip_offset_mm.0 - syn.e0.0).hypot(analysis.runout.tip_offset_mm.1 - syn.e0.1) * 1e3,
-            (analysis.runout.tilt.0 - syn.tilt.0).hypot(analysis.runout.tilt.1 - syn.tilt.1) * 1e3,
+            (analysis.runout.tip_offset_mm()[0] - syn.e0.0).hypot(analysis.runout.tip_offset_mm()[1] - syn.e0.1) * 1e3,
+            (analysis.runout.line.tilt[0].value - syn.tilt.0).hypot(analysis.runout.line.tilt[1].value - syn.tilt.1) * 1e3,
         );
         assert!(
             ex < 0.02 && ey < 0.02,
@@ -348,7 +348,8 @@ fn round_trip_force_and_runout_over_300_revolutions() {
         // runout from the air-cut templates: offset at the tip and tilt (θ = 0 is t = 0 here,
         // or the pulse edge, which the synthetic puts at θ = 0 too)
         let r = &analysis.runout;
-        let (ox, oy) = r.tip_offset_mm;
+        let [ox, oy] = r.tip_offset_mm();
+        let [tx, ty] = r.line.tilt_vector();
         // offset within 0.1 µm and tilt within 0.005 µm/mm per component (noise 0.05 µm averaged
         // over 40 revolutions; the pulse edge is quantised to 1/20 kHz → ≤ 0.9° of phase)
         let tol_o = if pulse { 0.0002 } else { 0.0001 };
@@ -358,12 +359,11 @@ fn round_trip_force_and_runout_over_300_revolutions() {
             syn.e0
         );
         assert!(
-            (r.tilt.0 - syn.tilt.0).abs() < 5e-6 && (r.tilt.1 - syn.tilt.1).abs() < 5e-6,
-            "{:?} vs {:?}",
-            r.tilt,
+            (tx - syn.tilt.0).abs() < 5e-6 && (ty - syn.tilt.1).abs() < 5e-6,
+            "{tx} {ty} vs {:?}",
             syn.tilt
         );
-        assert!(r.offset_se_mm < 1e-4);
+        assert!(r.offset_se_mm() < 1e-4);
         assert!(analysis.saturated_samples == 0);
         assert!(analysis.warnings.is_empty(), "{:?}", analysis.warnings);
     }
@@ -532,8 +532,9 @@ proptest! {
         prop_assert!(ex < 0.02 && ey < 0.02, "errors {} {}", ex, ey);
         // offset within 0.1 µm and tilt within 0.005 µm/mm (16 air revolutions, 0.05 µm noise)
         let r = &an.runout;
-        prop_assert!((r.tip_offset_mm.0 - syn.offset_mm.0).hypot(r.tip_offset_mm.1 - syn.offset_mm.1) < 1e-4, "{:?} vs {:?}", r.tip_offset_mm, syn.offset_mm);
-        prop_assert!((r.tilt.0 - syn.tilt.0).hypot(r.tilt.1 - syn.tilt.1) < 5e-6, "{:?} vs {:?}", r.tilt, syn.tilt);
+        let ([ox, oy], [tx, ty]) = (r.tip_offset_mm(), r.line.tilt_vector());
+        prop_assert!((ox - syn.offset_mm.0).hypot(oy - syn.offset_mm.1) < 1e-4, "{} {} vs {:?}", ox, oy, syn.offset_mm);
+        prop_assert!((tx - syn.tilt.0).hypot(ty - syn.tilt.1) < 5e-6, "{} {} vs {:?}", tx, ty, syn.tilt);
     }
 }
 

@@ -13,13 +13,69 @@
 //! variable (`--time-var`: sample times, or a scalar sample rate), the file's sample rate, or
 //! `--sample-rate-hz`.
 
-use super::TableError;
+use thiserror::Error;
 use super::TableInput;
 use crate::formats::{self, BinaryRecording, Kind};
 use crate::recording::{Channel, ReadOptions, RecordingChunk, RecordingError, RecordingReader};
 use crate::textfile::quote;
 use crate::units::Quantity;
 use std::io::{BufRead, BufReader, Read};
+
+/// A problem reading a displacement signal (any recording format).
+#[derive(Debug, Error)]
+pub enum SignalError {
+    /// The file could not be read.
+    #[error("{file}: {message}")]
+    File {
+        /// File name.
+        file: String,
+        /// What happened.
+        message: String,
+    },
+    /// A required column is missing or a header is malformed.
+    #[error("{file}: header: {message}")]
+    Header {
+        /// File name.
+        file: String,
+        /// What is wrong and what was expected.
+        message: String,
+    },
+    /// A cell could not be read.
+    #[error("{file}:{line}: column `{column}`: {message}")]
+    Cell {
+        /// File name.
+        file: String,
+        /// 1-based line number.
+        line: u64,
+        /// Column name.
+        column: String,
+        /// What is wrong and what was expected.
+        message: String,
+    },
+    /// A row-level problem (wrong number of fields, irregular time step…).
+    #[error("{file}:{line}: {message}")]
+    Row {
+        /// File name.
+        file: String,
+        /// 1-based line number.
+        line: u64,
+        /// What is wrong.
+        message: String,
+    },
+    /// A problem at a sample of a binary recording (no lines).
+    #[error("{file}: sample {sample} (0-based): {message}")]
+    Sample {
+        /// File name.
+        file: String,
+        /// 0-based sample index.
+        sample: u64,
+        /// What is wrong.
+        message: String,
+    },
+    /// The recording reader's error (a signal is read through [`crate::recording`]).
+    #[error(transparent)]
+    Recording(Box<crate::recording::RecordingError>),
+}
 
 /// A raw displacement recording at a constant sample rate.
 #[derive(Debug, Clone, PartialEq)]
@@ -97,7 +153,7 @@ pub struct SignalOptions {
 pub fn read_signal<'a>(
     input: impl Into<TableInput<'a>>,
     section: &SignalSection,
-) -> Result<SignalTable, TableError> {
+) -> Result<SignalTable, SignalError> {
     read_signal_with(input, section, &SignalOptions::default())
 }
 
@@ -109,10 +165,10 @@ pub fn read_signal_with<'a>(
     input: impl Into<TableInput<'a>>,
     section: &SignalSection,
     options: &SignalOptions,
-) -> Result<SignalTable, TableError> {
+) -> Result<SignalTable, SignalError> {
     if let Some(f) = options.sample_rate_hz {
         if !(f.is_finite() && f > 0.0) {
-            return Err(TableError::File {
+            return Err(SignalError::File {
                 file: "--sample-rate-hz".into(),
                 message: format!("expected a positive number of Hz, got {f}"),
             });
@@ -145,34 +201,34 @@ impl Rows<'_> {
     }
 }
 
-fn recording_error(e: RecordingError) -> TableError {
+fn recording_error(e: RecordingError) -> SignalError {
     match e {
-        RecordingError::Io { file, error } => TableError::File {
+        RecordingError::Io { file, error } => SignalError::File {
             file,
             message: format!("cannot read: {}", crate::report::io_problem(&error)),
         },
-        RecordingError::NoData { file, .. } => TableError::File {
+        RecordingError::NoData { file, .. } => SignalError::File {
             file,
             message: "no data rows".into(),
         },
-        e => TableError::Recording(Box::new(e)),
+        e => SignalError::Recording(Box::new(e)),
     }
 }
 
 /// Open the input: detect the format by content; text as a table (every column delivered,
 /// `#` comments, line numbers), binary through [`formats`] with the reader's time base.
-fn open<'a>(input: TableInput<'a>, options: &SignalOptions) -> Result<Rows<'a>, TableError> {
+fn open<'a>(input: TableInput<'a>, options: &SignalOptions) -> Result<Rows<'a>, SignalError> {
     let (file, kind, head, rest): (String, Kind, Vec<u8>, Box<dyn Read + 'a>) = match input {
         TableInput::Path(path) => {
             let (path, selector) = formats::split_selector(path);
             let file = path.display().to_string();
-            let unreadable = |e: &std::io::Error| TableError::File {
+            let unreadable = |e: &std::io::Error| SignalError::File {
                 file: file.clone(),
                 message: format!("cannot read: {}", crate::report::io_problem(e)),
             };
             let f = std::fs::File::open(&path).map_err(|e| unreadable(&e))?;
             if f.metadata().map_err(|e| unreadable(&e))?.is_dir() {
-                return Err(TableError::File {
+                return Err(SignalError::File {
                     file,
                     message: "is a folder: expected a CSV file".into(),
                 });
@@ -184,7 +240,7 @@ fn open<'a>(input: TableInput<'a>, options: &SignalOptions) -> Result<Rows<'a>, 
                 return binary(opened, file, selector.as_deref(), options, bytes);
             }
             if let Some(sel) = selector {
-                return Err(TableError::File {
+                return Err(SignalError::File {
                     file,
                     message: format!("a selector (`:{sel}`) applies to .mat, TDMS, HDF5 and Parquet files, not to text"),
                 });
@@ -199,7 +255,7 @@ fn open<'a>(input: TableInput<'a>, options: &SignalOptions) -> Result<Rows<'a>, 
             (&mut reader)
                 .take(4096)
                 .read_to_end(&mut head)
-                .map_err(|e| TableError::File {
+                .map_err(|e| SignalError::File {
                     file: name.into(),
                     message: format!("cannot read: {}", crate::report::io_problem(&e)),
                 })?;
@@ -212,12 +268,12 @@ fn open<'a>(input: TableInput<'a>, options: &SignalOptions) -> Result<Rows<'a>, 
         let max = runout_core::limits::MAX_RESULT_BYTES as u64;
         rest.take(max + 1)
             .read_to_end(&mut bytes)
-            .map_err(|e| TableError::File {
+            .map_err(|e| SignalError::File {
                 file: file.clone(),
                 message: format!("cannot read: {}", crate::report::io_problem(&e)),
             })?;
         if bytes.len() as u64 > max {
-            return Err(TableError::File {
+            return Err(SignalError::File {
                 file,
                 message: format!("more than {max} bytes in memory (limit MAX_RESULT_BYTES): pass the file by path"),
             });
@@ -244,7 +300,7 @@ fn binary<'a>(
     selector: Option<&str>,
     options: &SignalOptions,
     bytes: Option<u64>,
-) -> Result<Rows<'a>, TableError> {
+) -> Result<Rows<'a>, SignalError> {
     let sel = formats::selectable(&opened.catalog, &file, selector).map_err(recording_error)?;
     let names: Vec<(String, Channel)> = sel
         .iter()
@@ -308,7 +364,7 @@ struct Roles {
 
 type Plan = Roles;
 
-fn plan(rows: &Rows<'_>, options: &SignalOptions) -> Result<Plan, TableError> {
+fn plan(rows: &Rows<'_>, options: &SignalOptions) -> Result<Plan, SignalError> {
     match rows {
         Rows::Text { file, reader } => roles(file, &reader.info().columns, options, true),
         Rows::Binary { file, names, .. } => {
@@ -336,7 +392,7 @@ fn roles(
     columns: &[Channel],
     options: &SignalOptions,
     text: bool,
-) -> Result<Roles, TableError> {
+) -> Result<Roles, SignalError> {
     let headers: Vec<String> = columns
         .iter()
         .map(|c| {
@@ -348,7 +404,7 @@ fn roles(
         })
         .collect();
     let lower: Vec<String> = headers.iter().map(|h| h.to_ascii_lowercase()).collect();
-    let header_err = |message: String| TableError::Header {
+    let header_err = |message: String| SignalError::Header {
         file: file.into(),
         message,
     };
@@ -366,7 +422,7 @@ fn roles(
         name,
     };
     // `base_<unit>` with a unit of `q`
-    let unit_column = |base: &str, q: Quantity| -> Result<Option<Role>, TableError> {
+    let unit_column = |base: &str, q: Quantity| -> Result<Option<Role>, SignalError> {
         let prefix = format!("{base}_");
         for (index, h) in lower.iter().enumerate() {
             let Some(unit) = h.strip_prefix(&prefix) else {
@@ -458,7 +514,7 @@ fn roles(
                 .filter(|s| !s.is_empty())
             {
                 let Some((key, src)) = item.split_once('=') else {
-                    return Err(TableError::File {
+                    return Err(SignalError::File {
                         file: "--channels".into(),
                         message: format!(
                             "`{}`: expected `NAME = CHANNEL [unit]` (e.g. `a = Dx [um], pulse = trig`)",
@@ -582,20 +638,20 @@ impl std::fmt::Display for At {
     }
 }
 
-fn at_error(file: &str, at: At, column: Option<&str>, message: String) -> TableError {
+fn at_error(file: &str, at: At, column: Option<&str>, message: String) -> SignalError {
     match (at, column) {
-        (At::Line(line), Some(c)) => TableError::Cell {
+        (At::Line(line), Some(c)) => SignalError::Cell {
             file: file.into(),
             line,
             column: c.into(),
             message,
         },
-        (At::Line(line), None) => TableError::Row {
+        (At::Line(line), None) => SignalError::Row {
             file: file.into(),
             line,
             message,
         },
-        (At::Sample(sample), c) => TableError::Sample {
+        (At::Sample(sample), c) => SignalError::Sample {
             file: file.into(),
             sample,
             message: match c {
@@ -612,7 +668,7 @@ fn collect(
     plan: &Plan,
     section: &SignalSection,
     options: &SignalOptions,
-) -> Result<SignalTable, TableError> {
+) -> Result<SignalTable, SignalError> {
     let file = rows.file().to_string();
     let from = section.from_s.unwrap_or(f64::NEG_INFINITY);
     let to = section.to_s.unwrap_or(f64::INFINITY);
@@ -627,7 +683,7 @@ fn collect(
     let mut chunk = RecordingChunk::default();
     let fs = options.sample_rate_hz;
     // a finite number times the role's factor
-    let cell = |v: f64, at: At, r: &Role| -> Result<f64, TableError> {
+    let cell = |v: f64, at: At, r: &Role| -> Result<f64, SignalError> {
         let x = v * r.factor;
         if !x.is_finite() {
             return Err(at_error(
@@ -700,13 +756,13 @@ fn collect(
         }
     }
     if n_rows == 0 {
-        return Err(TableError::File {
+        return Err(SignalError::File {
             file,
             message: "no data rows".into(),
         });
     }
     if times.is_empty() {
-        return Err(TableError::File {
+        return Err(SignalError::File {
             file,
             message: format!(
                 "no sample in the selected section [{}, {}] s; the signal's times run from {} s \
@@ -760,11 +816,11 @@ fn collect(
     })
 }
 
-fn check_time_grid(file: &str, col: &str, times: &[f64], ats: &[At]) -> Result<f64, TableError> {
+fn check_time_grid(file: &str, col: &str, times: &[f64], ats: &[At]) -> Result<f64, SignalError> {
     let n = times.len();
     let cell_error = |at: At, message: String| at_error(file, at, Some(col), message);
     if n < 2 {
-        return Err(TableError::File {
+        return Err(SignalError::File {
             file: file.into(),
             message: "a signal needs at least 2 samples".into(),
         });

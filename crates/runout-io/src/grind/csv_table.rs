@@ -1,54 +1,30 @@
-//! A small numeric CSV table reader: header names (trimmed, case-insensitive), `#` comment lines,
-//! every value parsed as f64 with the file line and column named on error.
+//! The grind tables (probe points, edge lines) on the shared table reader (`runout_io::table`):
+//! only the known columns are accepted, every value is a finite number, and every error is the
+//! shared [`LocatedError`] naming the file, the line and the column.
 
-use std::collections::HashMap;
+use crate::table::{self, Column};
+use crate::LocatedError;
 
-/// A CSV problem with its position.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}{}: {message}", .line.map(|l| format!(", line {l}")).unwrap_or_default())]
-pub struct CsvError {
-    /// File name as given.
-    pub file: String,
-    /// 1-based line, if the problem is in one line.
-    pub line: Option<usize>,
-    /// What is wrong and what was expected.
-    pub message: String,
-}
+/// A grind CSV problem with its position: the shared [`LocatedError`]
+/// (`file[:line[:column]]: message`).
+pub type CsvError = LocatedError;
 
-/// Parsed numeric table.
+/// A parsed grind table.
 pub(crate) struct Table {
-    pub file: String,
-    pub index: HashMap<String, usize>,
-    /// (line number, values) per data row; empty cells are `None`.
-    pub rows: Vec<(usize, Vec<Option<f64>>)>,
+    t: table::Table,
+    /// (line number) per data row.
+    pub rows: Vec<(usize,)>,
 }
 
 impl Table {
     pub fn parse(text: &str, file: &str, known: &[&str]) -> Result<Table, CsvError> {
-        let err = |line: Option<usize>, message: String| CsvError {
-            file: file.into(),
-            line,
-            message,
-        };
-        let mut rdr = csv::ReaderBuilder::new()
-            .comment(Some(b'#'))
-            .trim(csv::Trim::All)
-            .from_reader(text.as_bytes());
-        let headers = rdr
-            .headers()
-            .map_err(|e| err(None, format!("cannot read the header: {e}")))?
-            .clone();
-        // the reader's position of the header does not count the comment lines before it
-        let header_line = text
-            .lines()
-            .position(|l| !l.trim().is_empty() && !l.starts_with('#'))
-            .map_or(1, |i| i + 1);
-        let names: Vec<String> = headers.iter().map(|h| h.to_ascii_lowercase()).collect();
-        let mut index = HashMap::new();
-        for (k, n) in names.iter().enumerate() {
+        let t = table::parse_text(file, text, false)?;
+        let mut seen: Vec<&str> = Vec::new();
+        for n in &t.lower {
             if !known.contains(&n.as_str()) {
-                return Err(err(
-                    Some(header_line),
+                return Err(CsvError::new(
+                    file,
+                    t.header_line,
                     format!(
                         "unknown column `{}` (expected some of: {})",
                         crate::textfile::quote(n),
@@ -56,80 +32,44 @@ impl Table {
                     ),
                 ));
             }
-            if index.insert(n.clone(), k).is_some() {
-                return Err(err(
-                    Some(header_line),
+            if seen.contains(&n.as_str()) {
+                return Err(CsvError::new(
+                    file,
+                    t.header_line,
                     format!("column `{n}` appears twice"),
                 ));
             }
+            seen.push(n);
         }
-        let mut rows = Vec::new();
-        for rec in rdr.records() {
-            let rec = rec.map_err(|e| {
-                let line = e.position().map(|p| p.line() as usize);
-                err(line, format!("malformed CSV: {e}"))
-            })?;
-            let line = rec.position().map_or(0, |p| p.line() as usize);
-            let mut vals = Vec::with_capacity(rec.len());
-            for (k, cell) in rec.iter().enumerate() {
-                if cell.is_empty() {
-                    vals.push(None);
-                    continue;
-                }
-                let v: f64 = cell
-                    .parse()
-                    .ok()
-                    .filter(|v: &f64| v.is_finite())
-                    .ok_or_else(|| {
-                        err(
-                            Some(line),
-                            format!(
-                                "column `{}`: `{}` is not a finite number",
-                                names[k],
-                                crate::textfile::quote(cell)
-                            ),
-                        )
-                    })?;
-                vals.push(Some(v));
-            }
-            rows.push((line, vals));
+        if t.rows.is_empty() {
+            return Err(CsvError::new(file, 0, "no data rows"));
         }
-        if rows.is_empty() {
-            return Err(err(None, "no data rows".into()));
-        }
-        Ok(Table {
-            file: file.into(),
-            index,
-            rows,
-        })
+        let rows = t.rows.iter().map(|r| (r.0,)).collect();
+        Ok(Table { t, rows })
+    }
+
+    fn column(&self, name: &str) -> Option<Column> {
+        self.t.column(name)
     }
 
     pub fn has(&self, name: &str) -> bool {
-        self.index.contains_key(name)
+        self.t.has(name)
     }
 
     /// Value of column `name` in row `r`, required.
     pub fn get(&self, r: usize, name: &str) -> Result<f64, CsvError> {
-        self.opt(r, name)?.ok_or_else(|| CsvError {
-            file: self.file.clone(),
-            line: Some(self.rows[r].0),
-            message: format!("column `{name}` is empty"),
-        })
+        match self.column(name) {
+            Some(c) => self.t.number(r, &c),
+            None => Err(self.err(Some(self.rows[r].0), format!("no column `{name}`"))),
+        }
     }
 
     /// Value of column `name` in row `r` if the column exists and the cell is filled.
     pub fn opt(&self, r: usize, name: &str) -> Result<Option<f64>, CsvError> {
-        Ok(self
-            .index
-            .get(name)
-            .and_then(|&k| self.rows[r].1.get(k).copied().flatten()))
+        self.t.optional(r, self.column(name).as_ref())
     }
 
     pub fn err(&self, line: Option<usize>, message: String) -> CsvError {
-        CsvError {
-            file: self.file.clone(),
-            line,
-            message,
-        }
+        CsvError::new(&self.t.file, line.unwrap_or(0), message)
     }
 }

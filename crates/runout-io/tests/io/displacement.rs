@@ -43,7 +43,7 @@ fn tooth_table_errors_name_file_line_column() {
     let p = file(&d, "bad.csv", "tooth,reading_um\n0,1\n1,abc\n");
     let e = read_tooth_table(&p, 2).unwrap_err().to_string();
     assert!(
-        e.contains("bad.csv:3: column `reading_um`") && e.contains("abc"),
+        e.contains("bad.csv:3:2: `abc` in column `reading_um` is not a number"),
         "{e}"
     );
     let p = file(&d, "nan.csv", "tooth,reading_um\n0,NaN\n");
@@ -52,7 +52,7 @@ fn tooth_table_errors_name_file_line_column() {
     let p = file(&d, "range.csv", "tooth,reading_um\n0,1\n5,1\n");
     let e = read_tooth_table(&p, 2).unwrap_err().to_string();
     assert!(
-        e.contains("range.csv:3: column `tooth`") && e.contains("0..2"),
+        e.contains("range.csv:3:1: column `tooth`") && e.contains("0..2"),
         "{e}"
     );
     let p = file(&d, "unit.csv", "tooth,reading_rpm\n0,1\n");
@@ -89,7 +89,7 @@ fn height_table() {
     let p = file(&d, "neg.csv", "z_mm,tir_um\n1,-3\n");
     let e = read_height_table(&p).unwrap_err().to_string();
     assert!(
-        e.contains("neg.csv:2: column `tir_um`") && e.contains("negative"),
+        e.contains("neg.csv:2:2: column `tir_um`") && e.contains("negative"),
         "{e}"
     );
 }

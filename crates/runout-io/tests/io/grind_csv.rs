@@ -39,7 +39,7 @@ fn reads_a_probe_grid_with_line_numbers() {
     // data start on line 3 (comment line 1, header line 2)
     assert_eq!(g.layers[0].rows, vec![3, 4, 5, 6]);
     let m = DeviationMap::new(&g);
-    assert!((m.axis.offset[0] - 0.006).abs() < 1e-12);
+    assert!((m.axis.offset[0].value - 0.006).abs() < 1e-12);
 }
 
 #[test]
@@ -64,13 +64,16 @@ fn errors_name_the_line() {
     let text = grid_text(&r).replace(",4,90,", ",4,9O,");
     let e = assemble(&text).unwrap_err();
     assert!(
-        e.contains("probe.csv, line 4") && e.contains("`angle_deg`") && e.contains("9O"),
+        e.contains("probe.csv:4:3: `9O` in column `angle_deg` is not a number"),
         "{e}"
     );
 
     r[5].3 = f64::NAN; // line 8
     let e = assemble(&grid_text(&r)).unwrap_err();
-    assert!(e.contains("line 8") && e.contains("radius_mm"), "{e}");
+    assert!(
+        e.contains("probe.csv:8:4: ") && e.contains("radius_mm"),
+        "{e}"
+    );
 
     let mut r = rows();
     r[9].3 = 3.4; // probe miss on line 12
@@ -103,11 +106,17 @@ fn errors_name_the_line() {
     assert!(e.contains("rows 3..4") && e.contains("at least 3"), "{e}");
 
     let e = read_probe_csv("layer,u,angle_deg,radius_mm\n0,1,2,3\n", "p.csv").unwrap_err();
-    assert!(e.to_string().contains("line 1") && e.to_string().contains("unknown column `u`"));
+    assert!(
+        e.to_string().starts_with("p.csv:1: unknown column `u`"),
+        "{e}"
+    );
     let e = read_probe_csv("layer,u_mm,angle_deg\n0,1,2\n", "p.csv").unwrap_err();
     assert!(e.to_string().contains("radius_mm"));
     let e = read_probe_csv("layer,u_mm,angle_deg,radius_mm\n0,1,2\n", "p.csv").unwrap_err();
-    assert!(e.to_string().contains("line 2"), "{e}");
+    assert!(
+        e.to_string().starts_with("p.csv:2: 3 fields, expected 4"),
+        "{e}"
+    );
 }
 
 #[test]

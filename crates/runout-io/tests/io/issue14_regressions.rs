@@ -37,10 +37,7 @@ fn grind_header_line_counts_comment_lines() {
     let e = read_probe_csv("# probe\n# more\nlayer,u_mm,angle_grad\n0,1,2\n", "p.csv")
         .unwrap_err()
         .to_string();
-    assert!(
-        e.starts_with("p.csv, line 3: unknown column `angle_grad`"),
-        "{e}"
-    );
+    assert!(e.starts_with("p.csv:3: unknown column `angle_grad`"), "{e}");
 }
 
 /// A gap in a raw signal was reported at the first sample (its step differed from the mean
@@ -58,7 +55,7 @@ fn a_signal_gap_is_reported_where_it_is() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("s.csv:5: column `time_s`: time step 7.000000e-3 s"),
+        e.contains("s.csv:5:1: column `time_s`: time step 7.000000e-3 s"),
         "{e}"
     );
     // evenly spaced with jitter well under half a step still reads

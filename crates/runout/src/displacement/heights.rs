@@ -118,8 +118,7 @@ pub fn heights(req: &HeightsRequest) -> Result<HeightsReport> {
         let (tip, top) = match &vector {
             Some(v) => {
                 let e = |z: f64| {
-                    let x = v.offset_at_zero_mm[0] + z * v.tilt[0];
-                    let y = v.offset_at_zero_mm[1] + z * v.tilt[1];
+                    let [x, y] = v.line.at(z);
                     (x.hypot(y) * 1e3, y.atan2(x).to_degrees())
                 };
                 (e(at), e(z_top))
@@ -218,9 +217,9 @@ pub fn heights(req: &HeightsRequest) -> Result<HeightsReport> {
         vector: vector.as_ref().map(|v| VectorReport {
             offset_um: v.offset_mm * 1e3,
             offset_um_se: v.offset_se_mm.map(|s| s * 1e3),
-            offset_at_zero_um: [v.offset_at_zero_mm[0] * 1e3, v.offset_at_zero_mm[1] * 1e3],
-            tilt_um_per_mm: [v.tilt[0] * 1e3, v.tilt[1] * 1e3],
-            residual_rms_um: v.residual_rms_mm * 1e3,
+            offset_at_zero_um: v.line.offset_mm().map(|x| x * 1e3),
+            tilt_um_per_mm: v.line.tilt_vector().map(|x| x * 1e3),
+            residual_rms_um: v.line.residual_rms * 1e3,
             angle: AngleReport::from(&v.angle),
         }),
         verdict: Some(verdict),

@@ -175,8 +175,8 @@ fn heights_body(r: &HeightsReport) -> String {
             "vector fit (offset + tilt, docs/methods.md §1.6): runout {:.3} µm, {}; tilt ({:.4}, {:.4}) µm/mm\n",
             v.offset_mm * 1e3,
             angle_text(&v.angle),
-            v.tilt[0] * 1e3,
-            v.tilt[1] * 1e3
+            v.line.tilt[0].value * 1e3,
+            v.line.tilt[1].value * 1e3
         );
     }
     s += &notes_text(&fit.notes);

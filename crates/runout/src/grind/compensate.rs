@@ -457,7 +457,7 @@ fn report(
 ) -> CompensateReport {
     let opts = &req.options;
     let ax = &map.axis;
-    let (o_mag, o_ang, o_lambda) = polar_um(ax.offset);
+    let (o_mag, o_ang, o_lambda) = polar_um(ax.offset_mm());
     let (u0, u1) = grid.u_range();
     let (rb, mb) = comp.before_stats();
     let (ra, ma) = comp.remaining_stats();
@@ -520,13 +520,13 @@ fn report(
             })
             .collect(),
         axis: AxisReport {
-            offset_at_u0_um: um2(ax.offset),
+            offset_at_u0_um: um2(ax.offset_mm()),
             offset_um: o_mag,
             offset_angle_bar_deg: o_ang,
             runout_angle_deg: o_lambda,
-            offset_um_se: ax.offset_se.map(um2),
-            tilt_um_per_mm: um2(ax.tilt),
-            tilt_um_per_mm_se: ax.tilt_se.map(um2),
+            offset_um_se: ax.offset_se().map(um2),
+            tilt_um_per_mm: um2(ax.tilt_vector()),
+            tilt_um_per_mm_se: ax.tilt_se().map(um2),
             layer_residual_rms_um: ax.residual_rms * 1e3,
             uncertainty: "standard errors from the residual scatter of the per-layer first harmonics about the line (null with 2 layers)".into(),
         },

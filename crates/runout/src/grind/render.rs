@@ -18,7 +18,7 @@ fn compensate_body(r: &CompensateReport) -> String {
     let mut s = String::new();
     let ax = &map.axis;
     let [u0, u1] = r.grid.u_range_mm;
-    let (o_mag, o_ang, lambda) = polar_um(ax.offset);
+    let (o_mag, o_ang, lambda) = polar_um(ax.offset_mm());
     let _ = writeln!(
         s,
         "runout grind compensate: {} layers, u {u0}..{u1} mm, scheme {}, outside range: {}",
@@ -37,9 +37,9 @@ fn compensate_body(r: &CompensateReport) -> String {
     let _ = writeln!(
         s,
         "bar axis at u = 0: offset ({:.2}, {:.2}) µm {} = {:.2} µm at {:.1}° (runout angle λ {:.1}°)",
-        ax.offset[0] * 1e3,
-        ax.offset[1] * 1e3,
-        se(ax.offset_se, 2),
+        ax.offset[0].value * 1e3,
+        ax.offset[1].value * 1e3,
+        se(ax.offset_se(), 2),
         o_mag,
         o_ang,
         lambda
@@ -47,9 +47,9 @@ fn compensate_body(r: &CompensateReport) -> String {
     let _ = writeln!(
         s,
         "tilt ({:.3}, {:.3}) µm/mm {}; layer residual rms {:.3} µm",
-        ax.tilt[0] * 1e3,
-        ax.tilt[1] * 1e3,
-        se(ax.tilt_se, 3),
+        ax.tilt[0].value * 1e3,
+        ax.tilt[1].value * 1e3,
+        se(ax.tilt_se(), 3),
         ax.residual_rms * 1e3
     );
     let _ = writeln!(

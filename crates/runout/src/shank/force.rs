@@ -805,13 +805,13 @@ fn summary(
         air_residual_rms_um: an.air_residual_rms_mm.iter().map(|v| v * 1e3).collect(),
         runout: RunoutReport {
             offset_um: ro.offset_magnitude_mm() * 1e3,
-            offset_um_se: ro.offset_se_mm * 1e3,
+            offset_um_se: ro.offset_se_mm() * 1e3,
             angle_deg: ro.offset_angle_rad().to_degrees(),
             at_height_above_tip_mm: ro.cutting_height_mm,
-            tip_offset_um: ro.tip_offset_mm.0.hypot(ro.tip_offset_mm.1) * 1e3,
-            tip_angle_deg: deg(ro.tip_offset_mm.0, ro.tip_offset_mm.1),
+            tip_offset_um: ro.tip_offset_mm()[0].hypot(ro.tip_offset_mm()[1]) * 1e3,
+            tip_angle_deg: deg(ro.tip_offset_mm()[0], ro.tip_offset_mm()[1]),
             tilt_um_per_mm: ro.tilt_magnitude() * 1e3,
-            tilt_um_per_mm_se: ro.tilt_se * 1e3,
+            tilt_um_per_mm_se: ro.tilt_se() * 1e3,
             tilt_angle_deg: ro.tilt_angle_rad().to_degrees(),
             angle_reference: angle_ref.into(),
             per_sensor: ro

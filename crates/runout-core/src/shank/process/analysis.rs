@@ -8,20 +8,16 @@ use super::super::template::{AngleTemplate, TemplateBuilder};
 use super::super::ShankError;
 #[allow(unused_imports)]
 use super::*;
+use crate::fit::{fit_offset_tilt, LineNoise, OffsetTiltFit};
 
 /// Runout of the tool from the air-cut templates (methods.md §3.2 end, §1.6).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShankRunout {
-    /// Offset vector at the cutting height (re, im) = ρ·e^{jλ}, mm; angle from θ = 0.
-    pub offset_mm: (f64, f64),
-    /// Standard error per component of the offset, mm.
-    pub offset_se_mm: f64,
-    /// Offset at the tool tip (z = 0), mm.
-    pub tip_offset_mm: (f64, f64),
-    /// Tilt vector T = dE/dz (mm/mm).
-    pub tilt: (f64, f64),
-    /// Standard error per component of the tilt (mm/mm).
-    pub tilt_se: f64,
+    /// The line e(z) = e₀ + z·τ through the templates' first harmonics at the two sensor heights
+    /// of every pair (z above the tip, spindle frame, angle from θ = 0), with standard errors from
+    /// the templates' own first-harmonic errors ([`LineNoise::Known`]). e₀ is the offset at the
+    /// tool tip (mm), τ = dE/dz the tilt (mm/mm).
+    pub line: OffsetTiltFit,
     /// Height above the tip of the reported offset, mm.
     pub cutting_height_mm: f64,
     /// Per pair and height: (z above tip mm, E re, E im) in the spindle frame, mm.
@@ -29,24 +25,51 @@ pub struct ShankRunout {
 }
 
 impl ShankRunout {
-    /// Offset magnitude ρ, mm.
+    /// Offset vector at the cutting height (re, im) = ρ·e^{jλ}, mm; angle from θ = 0.
+    pub fn offset_mm(&self) -> [f64; 2] {
+        self.line.at(self.cutting_height_mm)
+    }
+
+    /// Standard error per component of the offset at the cutting height, mm (the template noise is
+    /// isotropic, so both components have the same).
+    pub fn offset_se_mm(&self) -> f64 {
+        self.line
+            .at_variance(self.cutting_height_mm)
+            .map_or(f64::NAN, |v| v[0].sqrt())
+    }
+
+    /// Offset at the tool tip (z = 0), mm.
+    pub fn tip_offset_mm(&self) -> [f64; 2] {
+        self.line.offset_mm()
+    }
+
+    /// Standard error per component of the tilt, mm/mm.
+    pub fn tilt_se(&self) -> f64 {
+        self.line.tilt[0].se.unwrap_or(f64::NAN)
+    }
+
+    /// Offset magnitude ρ at the cutting height, mm.
     pub fn offset_magnitude_mm(&self) -> f64 {
-        self.offset_mm.0.hypot(self.offset_mm.1)
+        let [x, y] = self.offset_mm();
+        x.hypot(y)
     }
 
     /// Offset angle λ from the θ = 0 reference, rad (wrapped to (−π, π]).
     pub fn offset_angle_rad(&self) -> f64 {
-        self.offset_mm.1.atan2(self.offset_mm.0)
+        let [x, y] = self.offset_mm();
+        y.atan2(x)
     }
 
     /// Tilt magnitude, mm/mm.
     pub fn tilt_magnitude(&self) -> f64 {
-        self.tilt.0.hypot(self.tilt.1)
+        let [x, y] = self.line.tilt_vector();
+        x.hypot(y)
     }
 
     /// Tilt direction, rad.
     pub fn tilt_angle_rad(&self) -> f64 {
-        self.tilt.1.atan2(self.tilt.0)
+        let [x, y] = self.line.tilt_vector();
+        y.atan2(x)
     }
 }
 
@@ -458,48 +481,35 @@ pub(super) fn is_in(ranges: &[SampleRange], n: u64, pos: &mut usize) -> bool {
 }
 
 /// Offset and tilt from the first harmonics at the two heights of each pair (methods.md §1.6):
-/// E_wp = sign·E·e^{−jβ} (β = 0 for x, π/2 for y), heights z = l_tool − l above the tip,
-/// T = (E_II − E_I)/(z_II − z_I), E(z_c) = E_I + (z_c − z_I)·T, averaged over the pairs.
+/// E_wp = sign·E·e^{−jβ} (β = 0 for x, π/2 for y) at the heights z = l_tool − l above the tip; one
+/// line E(z) = e₀ + z·τ through all of them ([`fit_offset_tilt`]; with every pair at the same two
+/// heights it passes through the pair-averaged E_I and E_II), unweighted, each point carrying its
+/// template's first-harmonic standard error.
 fn runout_from_templates(s: &ShankSetup, templates: &[AngleTemplate]) -> ShankRunout {
     let zi = s.beam.tool_length_mm - s.beam.l1_mm;
     let zii = s.beam.tool_length_mm - s.beam.l2_mm;
-    let zc = s.cutting_height_mm;
     let rot = |e: (f64, f64), p: &SensorPair| {
         let (c, sn) = (p.axis.beta().cos(), p.axis.beta().sin());
         (p.sign * (e.0 * c + e.1 * sn), p.sign * (e.1 * c - e.0 * sn))
     };
-    let np = s.pairs.len() as f64;
-    let (mut off, mut tip, mut tilt) = ((0.0, 0.0), (0.0, 0.0), (0.0, 0.0));
-    let (mut off_var, mut tilt_var) = (0.0, 0.0);
-    let mut at = Vec::new();
+    let se = |t: &AngleTemplate| {
+        let (a, b) = t.first_harmonic_se;
+        ((a * a + b * b) / 2.0).sqrt()
+    };
+    let mut points = Vec::with_capacity(2 * s.pairs.len());
+    let mut sigma = Vec::with_capacity(2 * s.pairs.len());
     for (d, p) in s.pairs.iter().enumerate() {
-        let e1 = rot(templates[2 * d].first_harmonic, p);
-        let e2 = rot(templates[2 * d + 1].first_harmonic, p);
-        let se = |t: &AngleTemplate| {
-            let (a, b) = t.first_harmonic_se;
-            ((a * a + b * b) / 2.0).sqrt()
-        };
-        let (s1, s2) = (se(&templates[2 * d]), se(&templates[2 * d + 1]));
-        let t = ((e2.0 - e1.0) / (zii - zi), (e2.1 - e1.1) / (zii - zi));
-        let w = (zc - zi) / (zii - zi);
-        off.0 += (e1.0 + (zc - zi) * t.0) / np;
-        off.1 += (e1.1 + (zc - zi) * t.1) / np;
-        tip.0 += (e1.0 - zi * t.0) / np;
-        tip.1 += (e1.1 - zi * t.1) / np;
-        tilt.0 += t.0 / np;
-        tilt.1 += t.1 / np;
-        off_var += ((1.0 - w).powi(2) * s1 * s1 + w * w * s2 * s2) / (np * np);
-        tilt_var += (s1 * s1 + s2 * s2) / (zii - zi).powi(2) / (np * np);
-        at.push((zi, e1.0, e1.1));
-        at.push((zii, e2.0, e2.1));
+        for (k, z) in [(2 * d, zi), (2 * d + 1, zii)] {
+            let e = rot(templates[k].first_harmonic, p);
+            points.push((z, [e.0, e.1]));
+            sigma.push(se(&templates[k]));
+        }
     }
+    let line = fit_offset_tilt(&points, &LineNoise::Known(sigma))
+        .unwrap_or_else(|_| OffsetTiltFit::undetermined(points.len()));
     ShankRunout {
-        offset_mm: off,
-        offset_se_mm: off_var.sqrt(),
-        tip_offset_mm: tip,
-        tilt,
-        tilt_se: tilt_var.sqrt(),
-        cutting_height_mm: zc,
-        at_sensors: at,
+        line,
+        cutting_height_mm: s.cutting_height_mm,
+        at_sensors: points.iter().map(|(z, e)| (*z, e[0], e[1])).collect(),
     }
 }
