@@ -16,7 +16,7 @@ pub use signal::{
     read_signal, read_signal_with, SignalError, SignalOptions, SignalSection, SignalTable,
 };
 
-use crate::table::{self, Column, Table};
+use crate::table::{self, Table};
 use crate::units::Quantity;
 use crate::LocatedError;
 use runout_core::runout::seed::tooth_from_seed000_edge;

@@ -366,9 +366,4 @@ impl Table {
         )
         .at_column(col.index + 1)
     }
-
-    /// A problem with one row: `file:line: message`.
-    pub fn row_error(&self, line: usize, message: String) -> LocatedError {
-        LocatedError::new(&self.file, line, message)
-    }
 }

@@ -5,7 +5,7 @@
 //! * Enum values are snake_case or words, never Rust's Debug spelling (`PhaseTracking`,
 //!   `GenericCsv`, `FirstHarmonic`, `Joint`), neither as values nor as keys.
 //!
-//! Scanned: every CLI snapshot (`crates/runout-cli/tests/snapshots`, the JSON the CLI writes)
+//! Scanned: every CLI snapshot (`crates/runout-cli/tests/cli/snapshots`, the JSON the CLI writes)
 //! and every published schema (`docs/schema`).
 
 use serde_json::Value;
@@ -25,7 +25,7 @@ fn snapshot_body(text: &str) -> &str {
 /// Every JSON document to scan: (name, value, is a schema).
 fn documents() -> Vec<(String, Value, bool)> {
     let mut out = Vec::new();
-    let snaps = root().join("crates/runout-cli/tests/snapshots");
+    let snaps = root().join("crates/runout-cli/tests/cli/snapshots");
     for e in std::fs::read_dir(&snaps).unwrap() {
         let p = e.unwrap().path();
         let text = std::fs::read_to_string(&p).unwrap();
