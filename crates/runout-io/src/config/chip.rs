@@ -275,7 +275,14 @@ pub fn parse_case_specs(file: &str, text: &str) -> Result<Vec<ChipCaseSpec>, Chi
             // the words first, so that an unknown one is named with its key
             word_key::<MotionKind>(&merged, "motion")
                 .and_then(|_| word_key::<Spindle>(&merged, "spindle"))
-                .map_err(|m| perr(format!("case {}: {m}", n + 1)))?;
+                .map_err(|message| match merged.get("name") {
+                    Some(toml::Value::String(name)) => ChipConfigError::Case {
+                        file: file.into(),
+                        case: name.clone(),
+                        message,
+                    },
+                    _ => perr(format!("case {}: {message}", n + 1)),
+                })?;
             toml::Value::Table(merged)
                 .try_into::<ChipCaseSpec>()
                 .map_err(|e| {
