@@ -5,7 +5,6 @@
 
 use std::path::Path;
 
-
 use crate::common::*;
 
 /// Run `runout ARGS --json -` from the repository root: (exit code, JSON).

@@ -5,7 +5,6 @@
 
 use std::path::Path;
 
-
 use crate::common::*;
 
 /// `runout batch` on the bundled example and a broken file, into `dir/summary.csv`; extra args.

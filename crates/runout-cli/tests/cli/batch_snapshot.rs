@@ -7,7 +7,6 @@
 
 use std::path::Path;
 
-
 use crate::common::*;
 
 /// The report's text with `tmp` as `[TMP]` and the wall-clock values as `"[wall-clock]"`.

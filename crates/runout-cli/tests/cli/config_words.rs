@@ -6,7 +6,6 @@
 
 use std::path::Path;
 
-
 use crate::common::*;
 
 /// `runout ARGS` fails with status 1; its stderr.

@@ -189,11 +189,12 @@ fn the_flag_parser_refuses_unknown_names() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--chip-modle"));
 }
 
-/// Run `runout ARGS` (must succeed); its stdout.
+/// Run `runout ARGS` (must succeed: exit 0, or 3 = ran but not fully identified, which is a
+/// report too); its stdout.
 fn stdout(args: &[&str]) -> String {
     let out = runout().args(args).output().unwrap();
     assert!(
-        out.status.success(),
+        matches!(out.status.code(), Some(0 | 3)),
         "{args:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );

@@ -12,7 +12,6 @@
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
-
 use crate::common::*;
 
 /// A minimal uncompressed MAT v5 writer (1×N double row vectors and scalars).

@@ -5,7 +5,6 @@
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-
 use crate::common::*;
 
 fn ex(name: &str) -> PathBuf {

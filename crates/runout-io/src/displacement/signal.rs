@@ -13,13 +13,13 @@
 //! variable (`--time-var`: sample times, or a scalar sample rate), the file's sample rate, or
 //! `--sample-rate-hz`.
 
-use thiserror::Error;
 use super::TableInput;
 use crate::formats::{self, BinaryRecording, Kind};
 use crate::recording::{Channel, ReadOptions, RecordingChunk, RecordingError, RecordingReader};
 use crate::textfile::quote;
 use crate::units::Quantity;
 use std::io::{BufRead, BufReader, Read};
+use thiserror::Error;
 
 /// A problem reading a displacement signal (any recording format).
 #[derive(Debug, Error)]

@@ -55,7 +55,7 @@ fn a_signal_gap_is_reported_where_it_is() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("s.csv:5:1: column `time_s`: time step 7.000000e-3 s"),
+        e.contains("s.csv:5: column `time_s`: time step 7.000000e-3 s"),
         "{e}"
     );
     // evenly spaced with jitter well under half a step still reads
