@@ -169,7 +169,7 @@ def test_bad_arguments_raise():
         runout.displacement_heights({})
     with pytest.raises(runout.RunoutError, match="method: `ridge` is not ols | eq6"):
         runout.displacement_heights({"z_mm": z, "tir_um": tir}, method="ridge")
-    with pytest.raises(runout.RunoutError, match="not a finite number|nan"):
+    with pytest.raises(runout.RunoutError, match="is not finite"):
         runout.displacement_heights({"z_mm": z, "tir_um": tir * np.nan})
     with pytest.raises(runout.RunoutError, match="teeth and diameter_mm"):
         runout.displacement_signal({"time_s": [0, 1.0], "disp_a_um": [0, 1.0]}, teeth=4)
