@@ -13,80 +13,6 @@ use common::*;
 
 const FEEDS: [&str; 2] = ["cut_fz0.05.txt", "cut_fz0.08.txt"];
 
-/// Time, Fx, Fy, Fz of a DynoWare example.
-fn columns(name: &str) -> [Vec<f64>; 4] {
-    let text = std::fs::read_to_string(example(&format!("identify/{name}"))).unwrap();
-    let mut cols: [Vec<f64>; 4] = Default::default();
-    for line in text.lines().skip_while(|l| !l.starts_with("Time,")).skip(2) {
-        for (c, v) in cols.iter_mut().zip(line.split(',')) {
-            c.push(v.parse().unwrap());
-        }
-    }
-    cols
-}
-
-/// A minimal uncompressed MAT v5 writer (1×N double row vectors and scalars).
-fn write_mat(path: &Path, vars: &[(&str, &[f64])]) {
-    let mut b = Vec::new();
-    let mut head = b"MATLAB 5.0 MAT-file, written by the runout test".to_vec();
-    head.resize(116, b' ');
-    b.extend_from_slice(&head);
-    b.extend_from_slice(&[0; 8]);
-    b.extend_from_slice(&0x0100u16.to_le_bytes());
-    b.extend_from_slice(b"IM");
-    let tag = |b: &mut Vec<u8>, ty: u32, n: usize| {
-        b.extend_from_slice(&ty.to_le_bytes());
-        b.extend_from_slice(&(n as u32).to_le_bytes());
-    };
-    for (name, v) in vars {
-        let pad = name.len().div_ceil(8) * 8;
-        let size = 16 + 16 + 8 + pad + 8 + v.len() * 8;
-        tag(&mut b, 14, size);
-        tag(&mut b, 6, 8);
-        b.extend_from_slice(&6u32.to_le_bytes());
-        b.extend_from_slice(&[0; 4]);
-        tag(&mut b, 5, 8);
-        b.extend_from_slice(&1i32.to_le_bytes());
-        b.extend_from_slice(&(v.len() as i32).to_le_bytes());
-        tag(&mut b, 1, name.len());
-        b.extend_from_slice(name.as_bytes());
-        b.resize(b.len() + pad - name.len(), 0);
-        tag(&mut b, 9, v.len() * 8);
-        for x in *v {
-            b.extend_from_slice(&x.to_le_bytes());
-        }
-    }
-    std::fs::write(path, b).unwrap();
-}
-
-/// A minimal one-segment TDMS writer (f64 channels of group `Force`, contiguous).
-fn write_tdms(path: &Path, chans: &[(&str, &[f64])]) {
-    let mut meta = Vec::new();
-    meta.extend_from_slice(&(chans.len() as u32).to_le_bytes());
-    for (name, v) in chans {
-        let p = format!("/'Force'/'{name}'");
-        meta.extend_from_slice(&(p.len() as u32).to_le_bytes());
-        meta.extend_from_slice(p.as_bytes());
-        meta.extend_from_slice(&20u32.to_le_bytes());
-        meta.extend_from_slice(&10u32.to_le_bytes());
-        meta.extend_from_slice(&1u32.to_le_bytes());
-        meta.extend_from_slice(&(v.len() as u64).to_le_bytes());
-        meta.extend_from_slice(&0u32.to_le_bytes());
-    }
-    let data: Vec<u8> = chans
-        .iter()
-        .flat_map(|(_, v)| v.iter().flat_map(|x| x.to_le_bytes()))
-        .collect();
-    let mut b = b"TDSm".to_vec();
-    b.extend_from_slice(&(2u32 | 4 | 8).to_le_bytes());
-    b.extend_from_slice(&4713u32.to_le_bytes());
-    b.extend_from_slice(&((meta.len() + data.len()) as u64).to_le_bytes());
-    b.extend_from_slice(&(meta.len() as u64).to_le_bytes());
-    b.extend(meta);
-    b.extend(data);
-    std::fs::write(path, b).unwrap();
-}
-
 /// Drop what names the input (file, format, format metadata, input paths) from identify's JSON.
 fn strip(v: &mut Value) {
     match v {
@@ -163,7 +89,7 @@ fn same_recording_in_csv_mat_tdms_gives_identical_identification() {
     let mut sets: Vec<(&str, Vec<PathBuf>)> =
         vec![("csv", vec![]), ("mat", vec![]), ("tdms", vec![])];
     for f in FEEDS {
-        let [t, x, y, z] = columns(f);
+        let [t, x, y, z] = example_columns(f);
         let stem = f.trim_end_matches(".txt");
         let csv = dir.path().join(format!("{stem}.csv"));
         let mut text = String::from("time_s,Fx_N,Fy_N,Fz_N\n");
@@ -183,7 +109,11 @@ fn same_recording_in_csv_mat_tdms_gives_identical_identification() {
             ],
         );
         let tdms = dir.path().join(format!("{stem}.bin")); // detected by content
-        write_tdms(&tdms, &[("time", &t), ("Fx", &x), ("Fy", &y), ("Fz", &z)]);
+        write_tdms(
+            &tdms,
+            "Force",
+            &[("time", &t), ("Fx", &x), ("Fy", &y), ("Fz", &z)],
+        );
         sets[0].1.push(csv);
         sets[1].1.push(mat);
         sets[2].1.push(tdms);

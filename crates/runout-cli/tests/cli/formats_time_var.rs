@@ -14,68 +14,6 @@ use std::path::{Path, PathBuf};
 
 use crate::common::*;
 
-/// A minimal uncompressed MAT v5 writer (1×N double row vectors and scalars).
-fn write_mat(path: &Path, vars: &[(&str, &[f64])]) {
-    let mut b = Vec::new();
-    let mut head = b"MATLAB 5.0 MAT-file, written by the runout test".to_vec();
-    head.resize(116, b' ');
-    b.extend_from_slice(&head);
-    b.extend_from_slice(&[0; 8]);
-    b.extend_from_slice(&0x0100u16.to_le_bytes());
-    b.extend_from_slice(b"IM");
-    let tag = |b: &mut Vec<u8>, ty: u32, n: usize| {
-        b.extend_from_slice(&ty.to_le_bytes());
-        b.extend_from_slice(&(n as u32).to_le_bytes());
-    };
-    for (name, v) in vars {
-        let pad = name.len().div_ceil(8) * 8;
-        let size = 16 + 16 + 8 + pad + 8 + v.len() * 8;
-        tag(&mut b, 14, size);
-        tag(&mut b, 6, 8);
-        b.extend_from_slice(&6u32.to_le_bytes());
-        b.extend_from_slice(&[0; 4]);
-        tag(&mut b, 5, 8);
-        b.extend_from_slice(&1i32.to_le_bytes());
-        b.extend_from_slice(&(v.len() as i32).to_le_bytes());
-        tag(&mut b, 1, name.len());
-        b.extend_from_slice(name.as_bytes());
-        b.resize(b.len() + pad - name.len(), 0);
-        tag(&mut b, 9, v.len() * 8);
-        for x in *v {
-            b.extend_from_slice(&x.to_le_bytes());
-        }
-    }
-    std::fs::write(path, b).unwrap();
-}
-
-/// A minimal one-segment TDMS writer (f64 channels of group `Probe`, contiguous).
-fn write_tdms(path: &Path, chans: &[(&str, &[f64])]) {
-    let mut meta = Vec::new();
-    meta.extend_from_slice(&(chans.len() as u32).to_le_bytes());
-    for (name, v) in chans {
-        let p = format!("/'Probe'/'{name}'");
-        meta.extend_from_slice(&(p.len() as u32).to_le_bytes());
-        meta.extend_from_slice(p.as_bytes());
-        meta.extend_from_slice(&20u32.to_le_bytes());
-        meta.extend_from_slice(&10u32.to_le_bytes());
-        meta.extend_from_slice(&1u32.to_le_bytes());
-        meta.extend_from_slice(&(v.len() as u64).to_le_bytes());
-        meta.extend_from_slice(&0u32.to_le_bytes());
-    }
-    let data: Vec<u8> = chans
-        .iter()
-        .flat_map(|(_, v)| v.iter().flat_map(|x| x.to_le_bytes()))
-        .collect();
-    let mut b = b"TDSm".to_vec();
-    b.extend_from_slice(&(2u32 | 4 | 8).to_le_bytes());
-    b.extend_from_slice(&4713u32.to_le_bytes());
-    b.extend_from_slice(&((meta.len() + data.len()) as u64).to_le_bytes());
-    b.extend_from_slice(&(meta.len() as u64).to_le_bytes());
-    b.extend(meta);
-    b.extend(data);
-    std::fs::write(path, b).unwrap();
-}
-
 /// The columns of a CSV file (header names, values parsed as Rust parses them).
 fn csv_columns(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).unwrap();
@@ -182,7 +120,7 @@ fn displacement_signal_reads_mat_and_tdms_to_the_identical_json() {
     let mat = dir.path().join("signal.mat");
     write_mat(&mat, &vars);
     let tdms = dir.path().join("signal.dat"); // detected by content
-    write_tdms(&tdms, &vars);
+    write_tdms(&tdms, "Probe", &vars);
     for f in [&mat, &tdms] {
         let v = json_of(&SIGNAL, f, &SIGNAL_FLAGS);
         assert_eq!(v, reference, "{} differs from the CSV", f.display());
@@ -257,18 +195,6 @@ fn displacement_signal_time_var_and_sample_rate() {
     assert!(e.contains("zeit") && e.contains("clock_ms"), "{e}");
 }
 
-/// Time, Fx, Fy, Fz of a DynoWare example.
-fn dynoware_columns(name: &str) -> [Vec<f64>; 4] {
-    let text = std::fs::read_to_string(example(&format!("identify/{name}"))).unwrap();
-    let mut cols: [Vec<f64>; 4] = Default::default();
-    for line in text.lines().skip_while(|l| !l.starts_with("Time,")).skip(2) {
-        for (c, v) in cols.iter_mut().zip(line.split(',')) {
-            c.push(v.parse().unwrap());
-        }
-    }
-    cols
-}
-
 fn identify_args(file: &Path) -> Vec<String> {
     vec![
         "identify".into(),
@@ -315,7 +241,7 @@ fn identify_fails(file: &Path, extra: &[&str]) -> String {
 #[test]
 fn identify_time_var_in_a_mat_file() {
     let dir = tempfile::tempdir().unwrap();
-    let [t, x, y, z] = dynoware_columns("cut_fz0.05.txt");
+    let [t, x, y, z] = example_columns("cut_fz0.05.txt");
     let p = dir.path().join("r.mat");
     write_mat(
         &p,
