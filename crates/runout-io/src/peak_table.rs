@@ -171,7 +171,10 @@ pub fn parse_csv(file: &str, text: &str) -> Result<PeakTable, PeakTableError> {
             PeakTableError::new(
                 file,
                 hl,
-                format!("no column `{name}` (columns: {})", t.headers.join(", ")),
+                format!(
+                    "no column `{name}` (columns: {})",
+                    crate::textfile::quote(&t.headers.join(", "))
+                ),
             )
         })
     };
