@@ -70,7 +70,10 @@ pub fn read_tooth_table<'a>(
             t.cell_error(
                 *line,
                 &tooth_col,
-                format!("`{text}` is not a tooth number (integer)"),
+                format!(
+                    "`{}` is not a tooth number (integer)",
+                    crate::textfile::quote(text)
+                ),
             )
         })?;
         let tooth = if seed {

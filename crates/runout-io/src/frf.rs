@@ -47,7 +47,7 @@ pub fn parse_frf(file: &str, text: &str) -> Result<MeasuringChain, FrfError> {
     }
     let t = crate::table::parse_text(file, text, true)?;
     let hline = t.header_line;
-    let header = t.headers.join(", ");
+    let header = crate::textfile::quote(&t.headers.join(", "));
     let freq = t
         .column("freq_hz")
         .or_else(|| t.column("frequency_hz"))

@@ -362,7 +362,7 @@ impl Table {
         LocatedError::new(
             &self.file,
             line,
-            format!("column `{}`: {message}", col.name),
+            format!("column `{}`: {message}", crate::textfile::quote(&col.name)),
         )
         .at_column(col.index + 1)
     }

@@ -264,7 +264,12 @@ impl Apt<'_> {
                 t.parse::<f64>()
                     .ok()
                     .filter(|v| v.is_finite())
-                    .ok_or_else(|| self.err(line, format!("{word}: `{t}` is not a number")))
+                    .ok_or_else(|| {
+                        self.err(
+                            line,
+                            format!("{word}: `{}` is not a number", crate::textfile::quote(t)),
+                        )
+                    })
             })
             .collect()
     }
@@ -340,7 +345,7 @@ impl Apt<'_> {
                 }
                 _ => {
                     let v: f64 = tok.parse().map_err(|_| {
-                        self.err(line, format!("FEDRAT: `{tok}` is not a number or MMPM/IPM"))
+                        self.err(line, format!("FEDRAT: `{}` is not a number or MMPM/IPM", crate::textfile::quote(tok)))
                     })?;
                     value = Some(v);
                 }
@@ -455,7 +460,11 @@ fn numeric_rows(file: &str, text: &str, header: &[&str]) -> Result<Vec<NumericRo
             if !ok {
                 return Err(err(
                     line,
-                    format!("header `{body}`: expected {}", header.join(",")),
+                    format!(
+                        "header `{}`: expected {}",
+                        crate::textfile::quote(body),
+                        header.join(",")
+                    ),
                 ));
             }
             continue;
@@ -479,7 +488,16 @@ fn numeric_rows(file: &str, text: &str, header: &[&str]) -> Result<Vec<NumericRo
                 f.parse::<f64>()
                     .ok()
                     .filter(|x| x.is_finite())
-                    .ok_or_else(|| err(line, format!("field {} (`{f}`) is not a number", q + 1)))
+                    .ok_or_else(|| {
+                        err(
+                            line,
+                            format!(
+                                "field {} (`{}`) is not a number",
+                                q + 1,
+                                crate::textfile::quote(f)
+                            ),
+                        )
+                    })
             })
             .collect::<Result<Vec<f64>, _>>()?;
         let feed_mm_min = if values.len() == full {

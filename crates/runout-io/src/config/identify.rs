@@ -268,7 +268,10 @@ pub fn resolve_identify(s: &Settings, recordings: usize) -> Result<IdentifyCase,
             return Err(ConfigError::Key {
                 source_name: s.origin("fit_tilt").unwrap_or("config").into(),
                 key: "fit_tilt".into(),
-                message: format!("expected true or false, got `{other}`"),
+                message: format!(
+                    "expected true or false, got `{}`",
+                    crate::textfile::quote(other)
+                ),
             })
         }
     };

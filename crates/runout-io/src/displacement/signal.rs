@@ -655,7 +655,7 @@ fn at_error(file: &str, at: At, column: Option<&str>, message: String) -> Signal
             file: file.into(),
             sample,
             message: match c {
-                Some(c) => format!("`{c}`: {message}"),
+                Some(c) => format!("`{}`: {message}", quote(c)),
                 None => message,
             },
         },

@@ -36,7 +36,7 @@ impl Table {
                 return Err(CsvError::new(
                     file,
                     t.header_line,
-                    format!("column `{n}` appears twice"),
+                    format!("column `{}` appears twice", crate::textfile::quote(n)),
                 ));
             }
             seen.push(n);

@@ -26,7 +26,10 @@ fn triple(t: &Table, r: usize, names: [&str; 3]) -> Result<[f64; 3], CsvError> {
     for (k, n) in names.iter().enumerate() {
         v[k] = t.get(r, n)?;
         if !v[k].is_finite() {
-            return Err(t.err(Some(t.rows[r].0), format!("column `{n}` is not finite")));
+            return Err(t.err(
+                Some(t.rows[r].0),
+                format!("column `{}` is not finite", crate::textfile::quote(n)),
+            ));
         }
     }
     Ok(v)

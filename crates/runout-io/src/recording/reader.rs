@@ -761,7 +761,11 @@ impl HeaderParts {
                     .filter(|u| !u.is_empty())
                 {
                     if unit.as_ref().is_some_and(|h| h != u) {
-                        warnings.push(format!("column `{header}`: unit row says `{u}`, using it"));
+                        warnings.push(format!(
+                            "column `{}`: unit row says `{}`, using it",
+                            crate::textfile::quote(&header),
+                            crate::textfile::quote(u)
+                        ));
                     }
                     unit = Some(u.clone());
                 }

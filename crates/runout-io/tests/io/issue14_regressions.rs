@@ -29,6 +29,12 @@ fn header_names_in_messages_are_short_and_on_one_line() {
     let probe = format!("layer,\"u_mm\n{long}\",angle_deg\n0,1,2\n");
     let e = read_probe_csv(&probe, "probe.csv").unwrap_err().to_string();
     assert!(e.lines().count() == 1 && e.len() < 400, "{e}");
+    // an FRF table whose comment lost its `#` and opens a quoted field that runs to the end
+    // (found by the mutated-inputs proptest in CI): the header is quoted, cut at 80 characters
+    let frf = format!("\" impact test, tool tip\nfreq_Hz, xx_re, xx_im, yy_re, yy_im\n{long}");
+    let e = parse_frf("frf.csv", &frf).unwrap_err().to_string();
+    assert!(e.lines().count() == 1 && e.len() < 400, "{e}");
+    assert!(e.contains("no `freq_Hz` column"), "{e}");
 }
 
 /// The header of a grind table after comment lines was reported on line 1.
