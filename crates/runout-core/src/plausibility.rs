@@ -488,7 +488,7 @@ pub fn force_magnitude(
     let shear = geometry.shear[0].hypot(geometry.shear[1]);
     let ok = |m: &MeanForce| m.fz_mm > 0.0 && m.fxy_n.iter().all(|v| v.is_finite());
     let forces: Vec<MeanForce> = forces.iter().copied().filter(ok).collect();
-    if !(shear > 0.0) || forces.is_empty() {
+    if shear.is_nan() || shear <= 0.0 || forces.is_empty() {
         return None;
     }
     let n = forces.len() as f64;
