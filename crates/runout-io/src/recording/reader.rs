@@ -844,8 +844,7 @@ fn read_dynoware_header<R: BufRead>(
             return Err(header_err(
                 n,
                 format!(
-                    "DynoWare header longer than {} bytes without a channel-name row (limit \
-                     MAX_HEADER_BYTES)",
+                    "DynoWare header longer than {} bytes without a channel-name row",
                     runout_core::limits::MAX_HEADER_BYTES
                 ),
             ));
