@@ -718,21 +718,22 @@ impl<R: BufRead> RecordingReader<R> {
         let mut n_fields = 0;
         let mut time = None;
         let mut failure = None;
-        for (j, f) in fields(row, delim).enumerate() {
+        // the fields of the row by position (as `fields`), each parsed where it lies
+        let mut start = 0;
+        for j in 0.. {
+            let end = row[start..]
+                .iter()
+                .position(|&c| c == delim)
+                .map_or(row.len(), |k| start + k);
+            let f = &row[start..end];
             n_fields = j + 1;
             match self.slots.get(j) {
                 Some(Slot::Skip) => {}
-                Some(&Slot::Channel(k)) => match parse_number(f, dc) {
-                    Some(v) => {
-                        chunk.values[k].push(v);
-                    }
-                    None => {
-                        failure = Some(self.cell_error(line, row, j, f));
-                        break;
-                    }
-                },
-                Some(Slot::Time) => match parse_number(f, dc) {
-                    Some(v) => time = Some(v * self.time_scale),
+                Some(&slot) => match parse_number(f, dc) {
+                    Some(v) => match slot {
+                        Slot::Channel(k) => chunk.values[k].push(v),
+                        _ => time = Some(v * self.time_scale),
+                    },
                     None => {
                         failure = Some(self.cell_error(line, row, j, f));
                         break;
@@ -744,6 +745,10 @@ impl<R: BufRead> RecordingReader<R> {
                     break;
                 }
             }
+            if end == row.len() {
+                break;
+            }
+            start = end + 1;
         }
         if failure.is_none() && n_fields < self.slots.len() {
             failure = Some(self.field_count_error(line, row));
