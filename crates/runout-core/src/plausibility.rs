@@ -552,8 +552,11 @@ fn g(v: f64) -> String {
 fn magnitude_finding(subject: &str, cut: &str, ktc: f64, how: &str, range: (f64, f64)) -> Finding {
     let implied = if ktc.is_finite() && ktc < 1e9 {
         format!("K_tc ≈ {ktc:.0} N/mm²")
-    } else {
+    } else if ktc.is_finite() {
         format!("K_tc ≈ {ktc:.1e} N/mm²")
+    } else {
+        // a force over a vanishing f_z: no number to print (and never `inf` in a report)
+        "K_tc beyond 1e308 N/mm²".to_string()
     };
     Finding {
         code: "force_magnitude_contradicts_cut",
