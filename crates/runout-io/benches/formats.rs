@@ -55,10 +55,6 @@ fn bench(c: &mut Criterion) {
         "bench.parquet",
     ] {
         let p = dir.join(f);
-        if f.ends_with(".parquet") && !cfg!(feature = "parquet") {
-            eprintln!("formats bench: {f} skipped (build with --features parquet)");
-            continue;
-        }
         let bytes = std::fs::metadata(&p).map(|m| m.len()).unwrap_or(0);
         g.throughput(Throughput::Bytes(bytes));
         g.bench_function(f, |b| b.iter(|| black_box(read_all(&p))));

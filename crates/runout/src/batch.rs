@@ -12,7 +12,7 @@
 //! * **Resumable**: files already in the summary (ok or error) are skipped; rows are appended and
 //!   flushed one by one, so an interrupted run loses at most the analyses in flight. At the end the
 //!   table is rewritten sorted by file (atomically: temporary file + rename).
-//! * **Parquet** (cargo feature `parquet`): the same table, same columns, typed (numbers as
+//! * **Parquet**: the same table, same columns, typed (numbers as
 //!   nullable `DOUBLE`, text as UTF-8), written atomically at the end next to the CSV
 //!   ([`BatchRequest::parquet`], [`write_summary_parquet`]). The CSV stays the table a run resumes
 //!   from.
@@ -92,8 +92,8 @@ pub struct BatchRequest {
     pub threads: Option<usize>,
     /// Analyse again the files whose row in the summary is an error.
     pub retry_errors: bool,
-    /// Also write the final summary as Parquet to this file (needs the `parquet` feature; an
-    /// error naming the feature without it). [`parquet_next_to`] gives the usual name.
+    /// Also write the final summary as Parquet to this file. [`parquet_next_to`] gives the usual
+    /// name.
     pub parquet: Option<PathBuf>,
 }
 
@@ -218,7 +218,6 @@ pub fn write_summary(w: impl std::io::Write, rows: &[Row]) -> Result<()> {
 /// The summary as Parquet columns: the CSV's columns in the same order ([`columns`]), the
 /// [`TEXT_COLUMNS`] as UTF-8 text, every other one as a nullable 64-bit float (null where the
 /// CSV cell is empty).
-#[cfg(feature = "parquet")]
 pub fn summary_table(
     rows: &[Row],
 ) -> Result<Vec<(String, runout_io::formats::parquet::TableColumn)>> {
@@ -258,7 +257,6 @@ pub fn summary_table(
 }
 
 /// Write `rows` as the Parquet summary to `path`, atomically (temporary file + rename).
-#[cfg(feature = "parquet")]
 pub fn write_summary_parquet(path: &Path, rows: &[Row]) -> Result<()> {
     let table = summary_table(rows)?;
     let tmp = tmp_next_to(path);
@@ -272,17 +270,7 @@ pub fn write_summary_parquet(path: &Path, rows: &[Row]) -> Result<()> {
     Ok(())
 }
 
-/// Without the `parquet` feature: an error saying how to get it.
-#[cfg(not(feature = "parquet"))]
-pub fn write_summary_parquet(path: &Path, _rows: &[Row]) -> Result<()> {
-    bail!(
-        "{}: this build has no Parquet support (build with `--features parquet`)",
-        path.display()
-    )
-}
-
 /// The rows of a Parquet summary ([`write_summary_parquet`]).
-#[cfg(feature = "parquet")]
 pub fn read_summary_parquet(path: &Path) -> Result<Vec<Row>> {
     use runout_io::formats::parquet::TableColumn;
     let table = runout_io::formats::parquet::read_table(path)?;
@@ -503,9 +491,6 @@ where
 {
     let start = Instant::now();
     if let Some(p) = &req.parquet {
-        if !cfg!(feature = "parquet") {
-            write_summary_parquet(p, &[])?; // the error naming the feature
-        }
         if p == &req.summary {
             bail!(
                 "{}: the Parquet summary cannot be the CSV summary",

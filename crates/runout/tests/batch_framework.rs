@@ -215,40 +215,11 @@ fn identify_row_equals_the_identify_report() {
     assert_eq!(row.time, "");
 }
 
-/// Without the `parquet` feature, asking for a Parquet summary is an error naming the feature,
-/// before any recording is analysed.
-#[test]
-#[cfg(not(feature = "parquet"))]
-fn parquet_without_the_feature_is_refused_before_any_work() {
-    let dir = tempfile::tempdir().unwrap();
-    let (files, _) = make(dir.path(), 3);
-    let calls = AtomicUsize::new(0);
-    let req = BatchRequest {
-        files,
-        summary: dir.path().join("s.csv"),
-        threads: Some(1),
-        retry_errors: false,
-        parquet: Some(dir.path().join("s.parquet")),
-    };
-    let counted = |p: &Path| {
-        calls.fetch_add(1, Ordering::SeqCst);
-        analyse(p)
-    };
-    let e = format!("{:#}", batch::run(&req, counted, &|_| {}).unwrap_err());
-    assert!(
-        e.contains("s.parquet") && e.contains("--features parquet"),
-        "{e}"
-    );
-    assert_eq!(calls.load(Ordering::SeqCst), 0);
-    assert!(!req.summary.exists());
-}
-
-/// With the `parquet` feature: the Parquet summary holds the CSV's rows (read back equal, field
+/// The Parquet summary holds the CSV's rows (read back equal, field
 /// for field: the floats are the same f64, written as DOUBLE), same columns in the same order,
 /// numbers typed as DOUBLE with nulls where the CSV is empty, text as UTF-8; it is rewritten on a
 /// resumed run, and the CSV alone is what a run resumes from.
 #[test]
-#[cfg(feature = "parquet")]
 fn parquet_summary_equals_the_csv() {
     use runout::io::formats::parquet::{read_table, TableColumn};
     let dir = tempfile::tempdir().unwrap();

@@ -22,8 +22,7 @@ pub struct Args {
     #[arg(long, default_value = "runout-summary.csv")]
     pub summary: PathBuf,
     /// The summary also as Parquet (same columns; numbers as DOUBLE, text as UTF-8), written
-    /// atomically at the end. Default: the summary's name with `.parquet`, in a build with the
-    /// `parquet` feature (none without it).
+    /// atomically at the end. Default: the summary's name with `.parquet`.
     #[arg(long, value_name = "FILE")]
     pub parquet: Option<PathBuf>,
     /// Worker threads (recordings analysed at once); default the number of cores.
@@ -86,10 +85,11 @@ pub fn run(a: Args) -> Result<()> {
     for spec in &a.inputs {
         files.extend(batch::expand(spec)?);
     }
-    let parquet = a
-        .parquet
-        .clone()
-        .or_else(|| cfg!(feature = "parquet").then(|| batch::parquet_next_to(&a.summary)));
+    let parquet = Some(
+        a.parquet
+            .clone()
+            .unwrap_or_else(|| batch::parquet_next_to(&a.summary)),
+    );
     for out in [Some(&a.summary), a.json.as_ref(), parquet.as_ref()]
         .into_iter()
         .flatten()

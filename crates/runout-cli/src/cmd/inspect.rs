@@ -11,7 +11,7 @@ use std::path::PathBuf;
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// A recording of any supported format (detected by content): DynoWare/CSV/TSV text, MATLAB
-    /// .mat (v5, v7.3), NI TDMS, HDF5, Parquet (with the `parquet` build feature).
+    /// .mat (v5, v7.3), NI TDMS, HDF5, Parquet.
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
     /// Sample rate (Hz), for a text recording with neither a time column nor a sampling-rate line.

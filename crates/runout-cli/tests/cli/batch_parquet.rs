@@ -1,7 +1,6 @@
-//! `runout batch` with the `parquet` feature writes the summary also as Parquet next to the CSV
-//! (same columns, numbers as DOUBLE, text as UTF-8), equal to the CSV row for row; read back by
-//! pyarrow (an independent reader) in the ignored test that `.ci/run` runs. Without the feature,
-//! `--parquet FILE` is refused with a message naming the feature.
+//! `runout batch` writes the summary also as Parquet next to the CSV (same columns, numbers as
+//! DOUBLE, text as UTF-8), equal to the CSV row for row; read back by pyarrow (an independent
+//! reader) in the ignored test that `.ci/run` runs.
 
 use std::path::Path;
 
@@ -25,7 +24,6 @@ fn batch(dir: &Path, extra: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
-#[cfg(feature = "parquet")]
 fn summaries() -> (tempfile::TempDir, std::path::PathBuf, std::path::PathBuf) {
     let d = tempfile::tempdir().unwrap();
     let out = batch(d.path(), &[]);
@@ -42,7 +40,6 @@ fn summaries() -> (tempfile::TempDir, std::path::PathBuf, std::path::PathBuf) {
 }
 
 #[test]
-#[cfg(feature = "parquet")]
 fn the_parquet_summary_equals_the_csv() {
     let (d, csv, pq) = summaries();
     let rows = runout::batch::read_summary(&csv).unwrap();
@@ -69,7 +66,6 @@ fn the_parquet_summary_equals_the_csv() {
 /// text) and the CSV's values: text equal, numbers equal as doubles (the CSV writes the shortest
 /// round-trip decimal), empty CSV cells null.
 #[test]
-#[cfg(feature = "parquet")]
 #[ignore = "needs python3 with pyarrow (.ci/requirements.txt)"]
 fn pyarrow_reads_the_parquet_summary_as_the_csv() {
     let (_d, csv, pq) = summaries();
@@ -115,24 +111,4 @@ print("ok", checked)
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(String::from_utf8_lossy(&out.stdout).starts_with("ok "));
-}
-
-#[test]
-#[cfg(not(feature = "parquet"))]
-fn without_the_feature_parquet_is_refused() {
-    let d = tempfile::tempdir().unwrap();
-    let pq = d.path().join("s.parquet");
-    let out = batch(d.path(), &["--parquet", pq.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("s.parquet") && err.contains("--features parquet"),
-        "{err}"
-    );
-    assert!(!pq.exists() && !d.path().join("summary.csv").exists());
-    // and no Parquet file by default
-    let out = batch(d.path(), &[]);
-    assert!(out.status.success());
-    assert!(d.path().join("summary.csv").exists());
-    assert!(!d.path().join("summary.parquet").exists());
 }

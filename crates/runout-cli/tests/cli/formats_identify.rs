@@ -1,6 +1,5 @@
-//! Issue 16: the same recording as DynoWare text, CSV, MATLAB .mat, TDMS, HDF5 (and Parquet with
-//! the `parquet` feature) gives identical `runout identify` results, field by field of the JSON
-//! (only the file name, format and format metadata differ), every number to the last digit. The
+//! Issue 16: the same recording as DynoWare text, CSV, MATLAB .mat, TDMS, HDF5 and Parquet
+//! gives identical `runout identify` results, field by field of the JSON (only the file name, format and format metadata differ), every number to the last digit. The
 //! runs use one thread (`RAYON_NUM_THREADS=1`, as the snapshot tests): with several, the joint fits
 //! vary by up to 1.1e-7 relative between two runs on the *same* file (summation order), which is
 //! not a format difference. `runout inspect` on each format.
@@ -138,10 +137,7 @@ fn same_recording_written_by_scipy_nptdms_h5py_pyarrow_gives_identical_identific
         dir.path(),
         "dynoware",
     );
-    let mut exts = vec!["csv", "mat", "tdms", "h5"];
-    if cfg!(feature = "parquet") {
-        exts.push("parquet");
-    }
+    let exts = ["csv", "mat", "tdms", "h5", "parquet"];
     for f in FEEDS {
         let sub = dir.path().join(f.trim_end_matches(".txt"));
         let st = std::process::Command::new("python3")

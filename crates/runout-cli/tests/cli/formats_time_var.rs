@@ -345,10 +345,13 @@ fn displacement_signal_from_independent_writers_is_identical() {
         .expect("python3");
     assert!(st.success());
     let reference = json_of(&SIGNAL, &csv, &SIGNAL_FLAGS);
-    let mut files = vec!["signal.mat", "signal73.mat", "signal.h5", "signal.tdms"];
-    if cfg!(feature = "parquet") {
-        files.push("signal.parquet");
-    }
+    let files = [
+        "signal.mat",
+        "signal73.mat",
+        "signal.h5",
+        "signal.tdms",
+        "signal.parquet",
+    ];
     for f in files {
         let v = json_of(&SIGNAL, &dir.path().join(f), &SIGNAL_FLAGS);
         assert_eq!(v, reference, "{f} differs from the CSV");

@@ -1,7 +1,6 @@
 //! Raw displacement signals for `displacement signal`: a thin layer on the generic streaming
 //! recording reader ([`crate::recording`], [`crate::formats`]), so the signal is read from every
-//! recording format — CSV/TSV text, MATLAB `.mat` v5 / v7.3, NI TDMS, HDF5, Parquet (with the
-//! `parquet` feature). This layer only names the roles of the channels, converts units, keeps the
+//! recording format — CSV/TSV text, MATLAB `.mat` v5 / v7.3, NI TDMS, HDF5, Parquet. This layer only names the roles of the channels, converts units, keeps the
 //! selected section and checks the time grid; parsing, format detection and selection
 //! (`data.mat:600`) are the recording reader's.
 //!

@@ -1,5 +1,4 @@
-//! Binary recording formats (issue 16): MATLAB `.mat` (v5 and v7.3), NI TDMS, HDF5 and, behind the
-//! `parquet` cargo feature, Parquet. Each format is read into a [`Catalog`] (every array the file
+//! Binary recording formats (issue 16): MATLAB `.mat` (v5 and v7.3), NI TDMS, HDF5 and Parquet. Each format is read into a [`Catalog`] (every array the file
 //! holds: name, length, unit, rate) and a [`Source`] that delivers sample ranges of one array; a
 //! [`BinaryRecording`] then selects channels and the time base and yields the same
 //! [`RecordingInfo`] and [`RecordingChunk`]s as the CSV/DynoWare reader, so every job reads every format
@@ -20,7 +19,6 @@ pub mod arrays;
 pub mod detect;
 pub mod hdf5;
 pub mod mat;
-#[cfg(feature = "parquet")]
 pub mod parquet;
 pub mod tdms;
 
@@ -151,8 +149,8 @@ pub fn split_selector(spec: &Path) -> (PathBuf, Option<String>) {
 }
 
 /// Open a recording of any supported format, detected by content (magic bytes): DynoWare/CSV/TSV
-/// text, MATLAB `.mat` v5 / v7.3, NI TDMS, HDF5, Parquet (with the `parquet` feature). `path`
-/// may carry a selector, `data.mat:600` (see the module documentation).
+/// text, MATLAB `.mat` v5 / v7.3, NI TDMS, HDF5, Parquet. `path` may carry
+/// a selector, `data.mat:600` (see the module documentation).
 pub fn open_recording(
     path: impl AsRef<Path>,
     options: &ReadOptions,
@@ -237,10 +235,6 @@ fn unsupported(kind: Kind, file: &str) -> RecordingError {
     RecordingError::Format {
         file: file.into(),
         message: match kind {
-            Kind::Parquet => {
-                "a Parquet file: this build has no Parquet support (build with `--features parquet`)"
-                    .into()
-            }
             Kind::Mat4 => "a MATLAB v4 .mat file: save it as v5 (`save -v7`) or v7.3".into(),
             k => format!("unsupported format {k:?}"),
         },
@@ -253,7 +247,6 @@ pub fn open_kind(kind: Kind, path: &Path, file: &str) -> Result<Opened> {
         Kind::Mat5 => mat::open_path(path, file),
         Kind::Hdf5 { .. } => hdf5::open_path(path, file),
         Kind::Tdms => tdms::open_path(path, file),
-        #[cfg(feature = "parquet")]
         Kind::Parquet => parquet::open_path(path, file),
         k => Err(unsupported(k, file)),
     }
@@ -265,7 +258,6 @@ pub fn open_bytes(kind: Kind, bytes: &[u8], file: &str) -> Result<Opened> {
         Kind::Mat5 => mat::open_bytes(bytes, file),
         Kind::Hdf5 { .. } => hdf5::open_bytes(bytes, file),
         Kind::Tdms => tdms::open_bytes(bytes.to_vec(), file),
-        #[cfg(feature = "parquet")]
         Kind::Parquet => parquet::open_bytes(bytes.to_vec(), file),
         k => Err(unsupported(k, file)),
     }

@@ -145,7 +145,6 @@ proptest! {
 
 /// A file found by `cargo fuzz` (target `recording_parquet`) on which arrow-buffer 60.1 panics
 /// (`offset + len out of bounds`): a clear error naming the file, the panic contained.
-#[cfg(feature = "parquet")]
 #[test]
 fn parquet_decoder_panic_is_an_error() {
     for crash in ["7475dcc9", "3b91fd98"] {
@@ -153,7 +152,6 @@ fn parquet_decoder_panic_is_an_error() {
     }
 }
 
-#[cfg(feature = "parquet")]
 fn decoder_panic_is_an_error(path: &str) {
     let b = fixture(path);
     let name = "crash.parquet";

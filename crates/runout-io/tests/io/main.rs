@@ -8,6 +8,7 @@ mod displacement;
 mod error_chain;
 mod formats;
 mod formats_mutated;
+mod formats_parquet;
 mod formats_structured;
 mod gcode;
 mod grind_csv;
