@@ -22,8 +22,9 @@
 //! more than the iteration it saves (0.70 M points/s), so the start stays the planar one.
 
 use super::kinematics::{
-    pose_near, small_sin_cos, HeightGeometry, RigidStep, ToolKinematics, ToolMotion, Vec3,
+    pose_near, small_sin_cos, HeightGeometry, Pose, RigidStep, ToolKinematics, ToolMotion, Vec3,
 };
+use super::lanes;
 
 /// Newton settings: convergence tolerance (mm) and iteration cap per previous tooth.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,7 +83,7 @@ pub struct RayCrossing {
 
 /// Solve J·x = b for J = [c0 c1 c2] (columns) by Cramer's rule.
 #[inline]
-fn solve3(c0: &Vec3, c1: &Vec3, c2: &Vec3, b: &Vec3) -> Vec3 {
+pub(super) fn solve3(c0: &Vec3, c1: &Vec3, c2: &Vec3, b: &Vec3) -> Vec3 {
     let c12 = c1.cross(c2);
     let inv = 1.0 / c0.dot(&c12);
     Vec3::new(
@@ -114,6 +115,38 @@ pub struct Ray {
     pub step: Option<RigidStep>,
 }
 
+/// Everything of a [`Ray`] that depends on the time t only (pose, its screw, spindle angle):
+/// shared by the rays of every tooth and height at that time (no pose or libm `sin_cos` per ray).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RayTime {
+    /// Time t (s).
+    pub t: f64,
+    /// The tool pose at t.
+    pub pose: Pose,
+    /// (sin Θ(t), cos Θ(t)).
+    pub spin: (f64, f64),
+    /// The motion around t as a constant screw, when it is one ([`ToolMotion::rigid_step`]).
+    pub step: Option<RigidStep>,
+}
+
+impl RayTime {
+    /// Prepare time `t`.
+    #[inline]
+    pub fn new<M: ToolMotion>(kin: &ToolKinematics<M>, t: f64) -> Self {
+        let step = kin.motion().rigid_step(t);
+        let pose = match &step {
+            Some(s) => s.pose,
+            None => kin.motion().pose(t),
+        };
+        RayTime {
+            t,
+            pose,
+            spin: kin.spindle_angle(t).sin_cos(),
+            step,
+        }
+    }
+}
+
 impl Ray {
     /// Ray of `tooth` at height `z`, time `t` (slow path: prepares the height).
     pub fn new<M: ToolMotion>(kin: &ToolKinematics<M>, tooth: usize, z: f64, t: f64) -> Self {
@@ -128,12 +161,18 @@ impl Ray {
         tooth: usize,
         t: f64,
     ) -> Self {
-        let step = kin.motion().rigid_step(t);
-        let pose = match &step {
-            Some(s) => s.pose,
-            None => kin.motion().pose(t),
-        };
-        let spin = kin.spindle_angle(t).sin_cos();
+        Self::at_time(kin, geo, tooth, &RayTime::new(kin, t))
+    }
+
+    /// Ray of `tooth` on the prepared height `geo` at the prepared time `time`.
+    #[inline]
+    pub fn at_time<M: ToolMotion>(
+        kin: &ToolKinematics<M>,
+        geo: &HeightGeometry,
+        tooth: usize,
+        time: &RayTime,
+    ) -> Self {
+        let (pose, spin, step) = (time.pose, time.spin, time.step);
         let st = kin.edge_from_pose_sc(&pose, &geo.points[tooth], geo.z, spin.0, spin.1);
         let r = st.pos - st.axis_point;
         let radius = r.norm();
@@ -172,7 +211,7 @@ impl Ray {
 /// Returns the start x and (sin ψ, cos ψ) (the last step δ is applied to them to first order:
 /// |δ| ≲ 1e-9 rad after the first step, so the neglected δ²/2 is below 1e-18).
 #[inline]
-fn start_point<M: ToolMotion>(
+pub(super) fn start_point<M: ToolMotion>(
     kin: &ToolKinematics<M>,
     ray: &Ray,
     z: f64,
@@ -309,25 +348,58 @@ pub fn exact_at<M: ToolMotion>(
     t: f64,
     opts: &NewtonOptions,
 ) -> ExactIuct {
-    let ray = Ray::at(kin, geo, tooth, t);
-    let mut best = f64::NEG_INFINITY;
-    let mut cutting_m = 1;
-    let mut iterations = 0;
-    let mut converged = true;
-    for m in 1..=geo.teeth() {
-        let c = crossing_at(kin, geo, &ray, tooth, m, t, opts);
-        iterations += c.iterations;
-        converged &= c.converged;
-        if c.s > best {
-            best = c.s;
-            cutting_m = m;
+    exact_at_time(kin, geo, tooth, &RayTime::new(kin, t), opts)
+}
+
+/// Exact IUCT on a prepared height at a prepared time, eq. (2.2): the K Newton solves of
+/// eq. (2.3) run in lockstep, four previous passes per lane vector (`chip::lanes`), with the same
+/// operations in the same order as [`crossing_at`] in every lane, so the result is bit-identical
+/// to [`reference::exact_at`] (tested in tests/core/chip_models.rs).
+#[inline]
+pub fn exact_at_time<M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    geo: &HeightGeometry,
+    tooth: usize,
+    time: &RayTime,
+    opts: &NewtonOptions,
+) -> ExactIuct {
+    lanes::exact(kin, geo, tooth, time, opts)
+}
+
+/// The scalar solver, one previous pass after the other: the baseline of the lockstep
+/// [`exact_at_time`] (same values bit for bit; `benches/chip.rs` measures both in one run).
+#[doc(hidden)]
+pub mod reference {
+    use super::*;
+
+    /// Exact IUCT on a prepared height, eq. (2.2), by [`crossing_at`] for m = 1..=K in turn.
+    pub fn exact_at<M: ToolMotion>(
+        kin: &ToolKinematics<M>,
+        geo: &HeightGeometry,
+        tooth: usize,
+        t: f64,
+        opts: &NewtonOptions,
+    ) -> ExactIuct {
+        let ray = Ray::at(kin, geo, tooth, t);
+        let mut best = f64::NEG_INFINITY;
+        let mut cutting_m = 1;
+        let mut iterations = 0;
+        let mut converged = true;
+        for m in 1..=geo.teeth() {
+            let c = crossing_at(kin, geo, &ray, tooth, m, t, opts);
+            iterations += c.iterations;
+            converged &= c.converged;
+            if c.s > best {
+                best = c.s;
+                cutting_m = m;
+            }
         }
-    }
-    ExactIuct {
-        raw: ray.radius - best,
-        radius: ray.radius,
-        cutting_m,
-        iterations,
-        converged,
+        ExactIuct {
+            raw: ray.radius - best,
+            radius: ray.radius,
+            cutting_m,
+            iterations,
+            converged,
+        }
     }
 }
