@@ -172,8 +172,8 @@ impl Ray {
         tooth: usize,
         time: &RayTime,
     ) -> Self {
-        let (pose, spin, step) = (time.pose, time.spin, time.step);
-        let st = kin.edge_from_pose_sc(&pose, &geo.points[tooth], geo.z, spin.0, spin.1);
+        let (pose, spin, step) = (&time.pose, time.spin, time.step);
+        let st = kin.edge_from_pose_sc(pose, &geo.points[tooth], geo.z, spin.0, spin.1);
         let r = st.pos - st.axis_point;
         let radius = r.norm();
         let dir = r * (1.0 / radius);

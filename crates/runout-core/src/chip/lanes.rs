@@ -29,7 +29,18 @@ type F = [f64; L];
 
 #[inline(always)]
 fn lanes(f: impl FnMut(usize) -> f64) -> F {
-    std::array::from_fn(f)
+    fill(0.0, f)
+}
+
+/// [T; L] from a function of the lane (a plain loop: `std::array::from_fn` goes through a
+/// closure that is not always inlined into the SIMD entry).
+#[inline(always)]
+fn fill<T: Copy>(init: T, mut f: impl FnMut(usize) -> T) -> [T; L] {
+    let mut a = [init; L];
+    for (l, a) in a.iter_mut().enumerate() {
+        *a = f(l);
+    }
+    a
 }
 
 /// Four 3-vectors, structure of arrays. The operations round like nalgebra's `Vector3`
@@ -52,7 +63,7 @@ impl V {
     }
     #[inline(always)]
     fn gather(f: impl FnMut(usize) -> Vec3) -> V {
-        let v: [Vec3; L] = std::array::from_fn(f);
+        let v: [Vec3; L] = fill(Vec3::zeros(), f);
         V {
             x: lanes(|l| v[l].x),
             y: lanes(|l| v[l].y),
@@ -119,7 +130,11 @@ struct Poses {
 #[inline(always)]
 fn sin_cos(x: &F, active: &[bool; L]) -> (F, F) {
     let q = lanes(|l| x[l] * x[l]);
-    if (0..L).all(|l| !active[l] || q[l] < SMALL_ANGLE_SQ) {
+    let mut fast = true;
+    for l in 0..L {
+        fast &= !active[l] | (q[l] < SMALL_ANGLE_SQ);
+    }
+    if fast {
         let ps = lanes(|l| {
             SIN_TAYLOR[..4]
                 .iter()
@@ -137,7 +152,7 @@ fn sin_cos(x: &F, active: &[bool; L]) -> (F, F) {
             lanes(|l| 1.0 + q[l] * pc[l]),
         )
     } else {
-        let sc: [(f64, f64); L] = std::array::from_fn(|l| small_sin_cos(x[l]));
+        let sc: [(f64, f64); L] = fill((0.0, 0.0), |l| small_sin_cos(x[l]));
         (lanes(|l| sc[l].0), lanes(|l| sc[l].1))
     }
 }
@@ -157,8 +172,11 @@ fn poses<M: ToolMotion>(
     if let Some(st) = &time.step {
         let dt = lanes(|l| tl[l] - st.t);
         let angle = lanes(|l| st.rate * dt[l]);
-        let fast = (0..L)
-            .all(|l| !active[l] || (st.covers(tl[l]) && angle[l] * angle[l] < SMALL_ANGLE_SQ));
+        let mut fast = true;
+        for l in 0..L {
+            fast &= !active[l]
+                | ((tl[l] >= st.lo) & (tl[l] < st.hi) & (angle[l] * angle[l] < SMALL_ANGLE_SQ));
+        }
         if fast {
             let (s, c) = sin_cos(&angle, active);
             let one_c = lanes(|l| 1.0 - c[l]);
@@ -184,7 +202,7 @@ fn poses<M: ToolMotion>(
             return Poses { p, u, e1, v, w };
         }
     }
-    let poses: [_; L] = std::array::from_fn(|l| {
+    let poses: [_; L] = fill(time.pose, |l| {
         if active[l] {
             pose_near(kin.motion(), time.step.as_ref(), tl[l])
         } else {
@@ -228,11 +246,11 @@ fn solve_passes<M: ToolMotion>(
 ) -> Solved {
     let z = geo.z;
     let m_of = |l: usize| m0 + l.min(n - 1);
-    let prev: [usize; L] = std::array::from_fn(|l| geo.previous(tooth, m_of(l)));
-    let idx: [usize; L] = std::array::from_fn(|l| geo.pass_index(tooth, m_of(l)));
+    let prev: [usize; L] = fill(0, |l| geo.previous(tooth, m_of(l)));
+    let idx: [usize; L] = fill(0, |l| geo.pass_index(tooth, m_of(l)));
     let r_prev = lanes(|l| geo.radius[prev[l]]);
     let tau0 = lanes(|l| geo.tau_aligned[idx[l]]);
-    let live: [bool; L] = std::array::from_fn(|l| l < n);
+    let live: [bool; L] = fill(false, |l| l < n);
 
     // start, as `start_point`
     let origin = V::splat(&ray.origin);
@@ -290,10 +308,10 @@ fn solve_passes<M: ToolMotion>(
     // accepted iterate is the result)
     let mut bound = [f64::INFINITY; L];
     let mut it = 0;
-    while it < opts.max_iter && active.iter().any(|&a| a) {
+    while it < opts.max_iter && active != [false; L] {
         it += 1;
         // straight feed keeps z′ = z exactly, so the cached point is used
-        let sp: [_; L] = std::array::from_fn(|l| {
+        let sp: [_; L] = fill(geo.points[0], |l| {
             if x1[l] == z || !active[l] {
                 geo.points[prev[l]]
             } else {
@@ -352,10 +370,12 @@ fn solve_passes<M: ToolMotion>(
             }
         }
         // a pass whose crossing is certainly below another's does not decide h (eq. 2.2)
-        let floor = (0..L)
-            .filter(|&l| live[l])
-            .map(|l| x2[l] - bound[l])
-            .fold(f64::NEG_INFINITY, f64::max);
+        let mut floor = f64::NEG_INFINITY;
+        for l in 0..L {
+            if live[l] {
+                floor = floor.max(x2[l] - bound[l]);
+            }
+        }
         for l in 0..L {
             if active[l] && x2[l] + bound[l] < floor {
                 active[l] = false;
