@@ -83,7 +83,7 @@ pub struct RayCrossing {
 
 /// Solve J·x = b for J = [c0 c1 c2] (columns) by Cramer's rule.
 #[inline]
-pub(super) fn solve3(c0: &Vec3, c1: &Vec3, c2: &Vec3, b: &Vec3) -> Vec3 {
+fn solve3(c0: &Vec3, c1: &Vec3, c2: &Vec3, b: &Vec3) -> Vec3 {
     let c12 = c1.cross(c2);
     let inv = 1.0 / c0.dot(&c12);
     Vec3::new(
@@ -172,7 +172,21 @@ impl Ray {
         tooth: usize,
         time: &RayTime,
     ) -> Self {
-        let (pose, spin, step) = (&time.pose, time.spin, time.step);
+        Ray {
+            step: time.step,
+            ..Self::at_time_without_step(kin, geo, tooth, time)
+        }
+    }
+
+    /// [`Self::at_time`] with `step` left `None` (for solvers that take the screw from `time`).
+    #[inline]
+    pub(super) fn at_time_without_step<M: ToolMotion>(
+        kin: &ToolKinematics<M>,
+        geo: &HeightGeometry,
+        tooth: usize,
+        time: &RayTime,
+    ) -> Self {
+        let (pose, spin, step) = (&time.pose, time.spin, None);
         let st = kin.edge_from_pose_sc(pose, &geo.points[tooth], geo.z, spin.0, spin.1);
         let r = st.pos - st.axis_point;
         let radius = r.norm();
@@ -211,7 +225,7 @@ impl Ray {
 /// Returns the start x and (sin ψ, cos ψ) (the last step δ is applied to them to first order:
 /// |δ| ≲ 1e-9 rad after the first step, so the neglected δ²/2 is below 1e-18).
 #[inline]
-pub(super) fn start_point<M: ToolMotion>(
+fn start_point<M: ToolMotion>(
     kin: &ToolKinematics<M>,
     ray: &Ray,
     z: f64,

@@ -17,7 +17,7 @@
 //! instructions. Rust never contracts a·b + c into an FMA, so the vector code rounds like the
 //! scalar one.
 
-use super::exact::{start_point, ExactIuct, NewtonOptions, Ray, RayTime};
+use super::exact::{ExactIuct, NewtonOptions, Ray, RayTime};
 use super::kinematics::{
     pose_near, small_sin_cos, HeightGeometry, ToolKinematics, ToolMotion, Vec3, COS_TAYLOR,
     SIN_TAYLOR, SMALL_ANGLE_SQ,
@@ -62,13 +62,8 @@ impl V {
         }
     }
     #[inline(always)]
-    fn gather(f: impl FnMut(usize) -> Vec3) -> V {
-        let v: [Vec3; L] = fill(Vec3::zeros(), f);
-        V {
-            x: lanes(|l| v[l].x),
-            y: lanes(|l| v[l].y),
-            z: lanes(|l| v[l].z),
-        }
+    fn set(&mut self, l: usize, v: &Vec3) {
+        (self.x[l], self.y[l], self.z[l]) = (v.x, v.y, v.z);
     }
     #[inline(always)]
     fn add(&self, o: &V) -> V {
@@ -125,42 +120,38 @@ struct Poses {
     w: V,
 }
 
-/// [`small_sin_cos`] of every lane: the degree-9/10 polynomials in lanes when every active
-/// lane is in their range, else the scalar function per lane.
+/// [`small_sin_cos`] of every lane: the degree-9/10 polynomials in lanes, and the scalar
+/// function for the active lanes outside their range (|x| ≥ 1/8).
 #[inline(always)]
 fn sin_cos(x: &F, active: &[bool; L]) -> (F, F) {
     let q = lanes(|l| x[l] * x[l]);
-    let mut fast = true;
+    let ps = lanes(|l| {
+        SIN_TAYLOR[..4]
+            .iter()
+            .rev()
+            .fold(0.0, |acc, c| acc * q[l] + c)
+    });
+    let pc = lanes(|l| {
+        COS_TAYLOR[..5]
+            .iter()
+            .rev()
+            .fold(0.0, |acc, c| acc * q[l] + c)
+    });
+    let mut s = lanes(|l| x[l] + x[l] * q[l] * ps[l]);
+    let mut c = lanes(|l| 1.0 + q[l] * pc[l]);
     for l in 0..L {
-        fast &= !active[l] | (q[l] < SMALL_ANGLE_SQ);
+        // `!(q < …)`: NaN goes to the scalar function like in `small_sin_cos`
+        if active[l] && !(q[l] < SMALL_ANGLE_SQ) {
+            (s[l], c[l]) = small_sin_cos(x[l]);
+        }
     }
-    if fast {
-        let ps = lanes(|l| {
-            SIN_TAYLOR[..4]
-                .iter()
-                .rev()
-                .fold(0.0, |acc, c| acc * q[l] + c)
-        });
-        let pc = lanes(|l| {
-            COS_TAYLOR[..5]
-                .iter()
-                .rev()
-                .fold(0.0, |acc, c| acc * q[l] + c)
-        });
-        (
-            lanes(|l| x[l] + x[l] * q[l] * ps[l]),
-            lanes(|l| 1.0 + q[l] * pc[l]),
-        )
-    } else {
-        let sc: [(f64, f64); L] = fill((0.0, 0.0), |l| small_sin_cos(x[l]));
-        (lanes(|l| sc[l].0), lanes(|l| sc[l].1))
-    }
+    (s, c)
 }
 
 /// Poses at the times t + τ_l ([`pose_near`] of every active lane): the incremental screw
-/// rotation of [`super::RigidStep::pose_at`] in lanes when it applies to every active lane with
-/// a rotation in the degree-9/10 range of [`small_sin_cos`], else the scalar function per lane
-/// (inactive lanes then get the pose at t, unused).
+/// rotation of [`super::RigidStep::pose_at`] in lanes, and the scalar function for the active
+/// lanes where it does not apply with a rotation in the degree-9/10 range of [`small_sin_cos`]
+/// (a look-back across a CL-path junction, a motion without screw).
 #[inline(always)]
 fn poses<M: ToolMotion>(
     kin: &ToolKinematics<M>,
@@ -169,16 +160,16 @@ fn poses<M: ToolMotion>(
     active: &[bool; L],
 ) -> Poses {
     let tl = lanes(|l| time.t + tau[l]);
-    if let Some(st) = &time.step {
-        let dt = lanes(|l| tl[l] - st.t);
-        let angle = lanes(|l| st.rate * dt[l]);
-        let mut fast = true;
-        for l in 0..L {
-            fast &= !active[l]
-                | ((tl[l] >= st.lo) & (tl[l] < st.hi) & (angle[l] * angle[l] < SMALL_ANGLE_SQ));
-        }
-        if fast {
-            let (s, c) = sin_cos(&angle, active);
+    let mut scalar = *active;
+    let mut out = match &time.step {
+        Some(st) => {
+            let dt = lanes(|l| tl[l] - st.t);
+            let angle = lanes(|l| st.rate * dt[l]);
+            for l in 0..L {
+                scalar[l] &=
+                    !((tl[l] >= st.lo) & (tl[l] < st.hi) & (angle[l] * angle[l] < SMALL_ANGLE_SQ));
+            }
+            let (s, c) = sin_cos(&angle, &[false; L]);
             let one_c = lanes(|l| 1.0 - c[l]);
             let [cu, pu, ce, pe] = &st.terms;
             let u0 = V::splat(&st.pose.u);
@@ -199,23 +190,28 @@ fn poses<M: ToolMotion>(
                     vc.sub(&w.cross(&u).mul(&pivot)),
                 )
             };
-            return Poses { p, u, e1, v, w };
+            Poses { p, u, e1, v, w }
+        }
+        None => {
+            let p = V::splat(&time.pose.p);
+            let u = V::splat(&time.pose.u);
+            let e1 = V::splat(&time.pose.e1);
+            let v = V::splat(&time.pose.v);
+            let w = V::splat(&time.pose.w);
+            Poses { p, u, e1, v, w }
+        }
+    };
+    for l in 0..L {
+        if scalar[l] {
+            let q = pose_near(kin.motion(), time.step.as_ref(), tl[l]);
+            out.p.set(l, &q.p);
+            out.u.set(l, &q.u);
+            out.e1.set(l, &q.e1);
+            out.v.set(l, &q.v);
+            out.w.set(l, &q.w);
         }
     }
-    let poses: [_; L] = fill(time.pose, |l| {
-        if active[l] {
-            pose_near(kin.motion(), time.step.as_ref(), tl[l])
-        } else {
-            time.pose
-        }
-    });
-    Poses {
-        p: V::gather(|l| poses[l].p),
-        u: V::gather(|l| poses[l].u),
-        e1: V::gather(|l| poses[l].e1),
-        v: V::gather(|l| poses[l].v),
-        w: V::gather(|l| poses[l].w),
-    }
+    out
 }
 
 /// Crossings of up to four previous passes m0.. m0 + n − 1 (padding lanes repeat the last one
@@ -283,10 +279,6 @@ fn solve_passes<M: ToolMotion>(
             x0[l] = tau0[l] + psi[l] * kin.inv_omega();
         }
     }
-    debug_assert!({
-        let (x, turn) = start_point(kin, ray, z, time.t, tau0[0], r_prev[0]);
-        x == [x0[0], x1[0], x2[0]] && turn == (se[0], ce[0])
-    });
 
     // sin/cos of Θ(t + τ₀) by the addition theorem, as `crossing_at`
     let (st0, ct0) = ray.spin;
@@ -400,7 +392,7 @@ fn exact_impl<M: ToolMotion>(
     time: &RayTime,
     opts: &NewtonOptions,
 ) -> ExactIuct {
-    let ray = Ray::at_time(kin, geo, tooth, time);
+    let ray = Ray::at_time_without_step(kin, geo, tooth, time);
     let k = geo.teeth();
     let mut best = f64::NEG_INFINITY;
     let mut cutting_m = 1;
