@@ -4,9 +4,18 @@
 //!
 //! Every lane performs the same floating-point operations in the same order as the scalar
 //! solver (start of eq. 2.7 refined by two scalar Newton steps, then 3-D Newton with Cramer's
-//! rule and the quadratic stopping rule), so each crossing — and the IUCT — is bit-identical to
-//! [`super::exact::reference::exact_at`] (tested in tests/core/chip_models.rs). A lane whose
-//! Newton solve has converged is frozen while the others finish. Where a lane leaves the
+//! rule and the quadratic stopping rule), so each crossing that decides h — and the IUCT — is
+//! bit-identical to [`super::exact::reference::exact_at`] (tested in tests/core/chip_models.rs
+//! over realistic 5-axis cases). A lane whose Newton solve has converged is frozen while the
+//! others finish.
+//!
+//! Early stop of passes that cannot cut: h = R_i − max_m s_m (eq. 2.2) needs only the largest
+//! crossing. After a Newton step Δx the iterate's error is bounded by C·|Δx|² (quadratic
+//! convergence; C = `curvature` of the stopping rule, 20× the edge-curvature estimate, here
+//! × `PRUNE_SAFETY` = 4 more), and it is 0 for an accepted iterate (that is the result). A pass
+//! with s_m + bound_m < s_j − bound_j for another pass j is stopped: its converged crossing would
+//! be below s_j's, so the maximum, the cutting pass and h are those of the full solve. Typically
+//! only the cutting pass (and a near-tie) runs past the first iteration. Where a lane leaves the
 //! vector fast path — a look-back time outside the screw interval (a CL-path junction), a
 //! rotation or angle increment beyond the degree-9/10 range of [`small_sin_cos`], a spindle
 //! point at z′ ≠ z — that quantity is computed per lane by the scalar functions themselves.
@@ -16,6 +25,9 @@
 //! pose rotation, edge state, Jacobian and Cramer solve of four passes into vector
 //! instructions. Rust never contracts a·b + c into an FMA, so the vector code rounds like the
 //! scalar one.
+
+// Lane loops index several lane arrays in lockstep; `for l in 0..L` reads best there.
+#![allow(clippy::needless_range_loop)]
 
 use super::exact::{ExactIuct, NewtonOptions, Ray, RayTime};
 use super::kinematics::{
