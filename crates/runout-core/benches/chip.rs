@@ -1,4 +1,5 @@
-//! IUCT model throughput (points/s, one thread): exact (Newton, methods.md eq. 2.2–2.3) vs
+//! IUCT model throughput (points/s, one thread): exact (Newton, methods.md eq. 2.2–2.3; the
+//! lockstep solver and its scalar baseline `exact::reference`, bit-identical values) vs
 //! equivalent (eq. 2.8; bulk Hermite look-back of `chip::lookback`, and the direct per-point
 //! evaluation) vs arc (eq. 2.5), on the general 3-D kinematics and on the 3-axis trait path used
 //! by the force simulation. Cases: R 5, K 4, helix 30°, f_z 0.1, ρ 10 µm (methods.md
@@ -12,8 +13,8 @@
 use criterion::measurement::{Measurement, WallTime};
 use criterion::{BenchmarkGroup, Criterion, Throughput};
 use runout_core::chip::compare::{
-    arc_values, equivalent_values, equivalent_values_direct, exact_values, sample_grid, Motion,
-    SamplePoint,
+    arc_values, equivalent_values, equivalent_values_direct, exact_values, exact_values_reference,
+    sample_grid, Motion, SamplePoint,
 };
 use runout_core::chip::kinematics::small_sin_cos;
 use runout_core::chip::*;
@@ -97,6 +98,9 @@ fn general<T: Measurement>(c: &mut Criterion<T>, name: &str, kin: &ToolKinematic
     g.throughput(Throughput::Elements(pts.len() as u64));
     let params = EquivalentParams::default();
     g.bench_function("exact", |b| b.iter(|| exact_values(kin, black_box(&pts))));
+    g.bench_function("exact_reference", |b| {
+        b.iter(|| exact_values_reference(kin, black_box(&pts)))
+    });
     g.bench_function("equivalent", |b| {
         b.iter(|| equivalent_values(kin, black_box(&pts), &params))
     });
@@ -193,6 +197,7 @@ fn summary() {
         ("5-axis CL path", kin(cl_path())),
     ] {
         let ex = rate(pts.len(), || exact_values(&k, &pts).iter().sum());
+        let ex_ref = rate(pts.len(), || exact_values_reference(&k, &pts).iter().sum());
         let eq = rate(pts.len(), || {
             equivalent_values(&k, &pts, &params).iter().sum()
         });
@@ -200,6 +205,12 @@ fn summary() {
             equivalent_values_direct(&k, &pts, &params).iter().sum()
         });
         let ar = rate(pts.len(), || arc_values(&k, &pts).iter().sum());
+        println!(
+            "{name:>14} general: exact {:.3e} (scalar reference {:.3e}: {:.2}×)",
+            ex,
+            ex_ref,
+            ex / ex_ref
+        );
         println!(
             "{name:>14} general: exact {:.3e}  equivalent {:.3e} ({:.1}× exact; direct per point {:.3e}, {:.1}×)  arc {:.3e} ({:.1}× exact)",
             ex, eq, eq / ex, dir, dir / ex, ar, ar / ex

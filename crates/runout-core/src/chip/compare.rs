@@ -5,7 +5,7 @@
 //! * normalised MAE: Σ|Δh| / Σ h_exact over all points.
 
 use super::closed_form::{arc_at, closed_forms_at, equivalent_at, EquivalentParams};
-use super::exact::{exact_at, NewtonOptions};
+use super::exact::{exact_at_time, reference, NewtonOptions, RayTime};
 use super::kinematics::{
     CircularFeed, ClPath, ConstantSwing, HeightGeometry, JointPath, Pose, RigidStep, StraightFeed,
     ToolKinematics, ToolMotion,
@@ -147,9 +147,10 @@ pub fn evaluate_models<M: ToolMotion>(
         equivalent: equivalent_values(kin, points, params),
         ..Default::default()
     };
+    let mut time = None::<RayTime>;
     for q in points {
         let geo = heights.get(q.z);
-        let e = exact_at(kin, geo, q.tooth, q.t, &opts);
+        let e = exact_at_time(kin, geo, q.tooth, ray_time(kin, &mut time, q.t), &opts);
         v.unconverged += usize::from(!e.converged);
         v.exact.push(e.h());
         let c = closed_forms_at(kin, geo, q.tooth, q.t, params);
@@ -163,10 +164,43 @@ pub fn evaluate_models<M: ToolMotion>(
 pub fn exact_values<M: ToolMotion>(kin: &ToolKinematics<M>, points: &[SamplePoint]) -> Vec<f64> {
     let opts = NewtonOptions::default();
     let heights = Heights::new(kin, points);
+    let mut time = None::<RayTime>;
     points
         .iter()
-        .map(|q| exact_at(kin, heights.get(q.z), q.tooth, q.t, &opts).h())
+        .map(|q| {
+            let time = ray_time(kin, &mut time, q.t);
+            exact_at_time(kin, heights.get(q.z), q.tooth, time, &opts).h()
+        })
         .collect()
+}
+
+/// [`exact_values`] by the scalar baseline solver, one point and one previous pass after the
+/// other ([`super::exact::reference::exact_at`]): the same values bit for bit.
+#[doc(hidden)]
+pub fn exact_values_reference<M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    points: &[SamplePoint],
+) -> Vec<f64> {
+    let opts = NewtonOptions::default();
+    let heights = Heights::new(kin, points);
+    points
+        .iter()
+        .map(|q| reference::exact_at(kin, heights.get(q.z), q.tooth, q.t, &opts).h())
+        .collect()
+}
+
+/// The prepared time `t`, reused while consecutive points share it.
+#[inline]
+fn ray_time<'a, M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    cache: &'a mut Option<RayTime>,
+    t: f64,
+) -> &'a RayTime {
+    match cache {
+        Some(c) if c.t == t => {}
+        _ => *cache = Some(RayTime::new(kin, t)),
+    }
+    cache.as_ref().expect("set above")
 }
 
 /// Equivalent h (mm, ≥ 0) at `points` by the bulk [`EquivalentEvaluator`]: one look-back window

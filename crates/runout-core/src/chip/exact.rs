@@ -20,10 +20,22 @@
 //! on the CL path, 3-axis unchanged. A second-order analytic start for (τ, z′, s) in the turning
 //! frame was tried: it brings the swing to 1.00 Newton iteration per pass (from 2.2) but costs
 //! more than the iteration it saves (0.70 M points/s), so the start stays the planar one.
+//!
+//! Lockstep passes (issue 18 item 3): a callgrind profile showed the solver bound by instruction
+//! throughput (≈ 6 000 instructions per point, IPC ≈ 2.8), not by latency, trigonometry or
+//! allocation, so [`exact_at_time`] solves the K independent passes side by side in SIMD lanes
+//! (`chip::lanes`, same operations per lane → bit-identical to [`reference::exact_at`]), stops
+//! the passes whose crossing is bounded below another's (they cannot decide the max of eq. 2.2),
+//! and shares the pose, screw and spindle sin/cos of a time between the rays of every tooth and
+//! height at that time ([`RayTime`]). Measured in one run (thread CPU time, `benches/chip.rs`,
+//! load average 9–12 on 2 cores): 1.49 → 2.72 M points/s per core on the swing (1.83×),
+//! 1.26 → 2.51 M on the CL path (2.00×), 2.85 → 3.92 M in 3-axis (1.37×), scalar reference →
+//! lockstep.
 
 use super::kinematics::{
-    pose_near, small_sin_cos, HeightGeometry, RigidStep, ToolKinematics, ToolMotion, Vec3,
+    pose_near, small_sin_cos, HeightGeometry, Pose, RigidStep, ToolKinematics, ToolMotion, Vec3,
 };
+use super::lanes;
 
 /// Newton settings: convergence tolerance (mm) and iteration cap per previous tooth.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,9 +64,12 @@ pub struct ExactIuct {
     pub radius: f64,
     /// The m (1..=K) whose previous pass left the surface (largest s_m).
     pub cutting_m: usize,
-    /// Newton iterations summed over m.
+    /// Newton iterations summed over m (a pass stopped early because it cannot decide h counts
+    /// the iterations it made).
     pub iterations: u32,
-    /// True when every Newton solve met the tolerance.
+    /// True when every Newton solve that decides h met the tolerance (a pass whose crossing is
+    /// bounded below another pass's, s_m + C·|Δx|² < s_j − C·|Δx_j|², is stopped early and does
+    /// not count; see `chip::lanes`).
     pub converged: bool,
 }
 
@@ -114,6 +129,38 @@ pub struct Ray {
     pub step: Option<RigidStep>,
 }
 
+/// Everything of a [`Ray`] that depends on the time t only (pose, its screw, spindle angle):
+/// shared by the rays of every tooth and height at that time (no pose or libm `sin_cos` per ray).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RayTime {
+    /// Time t (s).
+    pub t: f64,
+    /// The tool pose at t.
+    pub pose: Pose,
+    /// (sin Θ(t), cos Θ(t)).
+    pub spin: (f64, f64),
+    /// The motion around t as a constant screw, when it is one ([`ToolMotion::rigid_step`]).
+    pub step: Option<RigidStep>,
+}
+
+impl RayTime {
+    /// Prepare time `t`.
+    #[inline]
+    pub fn new<M: ToolMotion>(kin: &ToolKinematics<M>, t: f64) -> Self {
+        let step = kin.motion().rigid_step(t);
+        let pose = match &step {
+            Some(s) => s.pose,
+            None => kin.motion().pose(t),
+        };
+        RayTime {
+            t,
+            pose,
+            spin: kin.spindle_angle(t).sin_cos(),
+            step,
+        }
+    }
+}
+
 impl Ray {
     /// Ray of `tooth` at height `z`, time `t` (slow path: prepares the height).
     pub fn new<M: ToolMotion>(kin: &ToolKinematics<M>, tooth: usize, z: f64, t: f64) -> Self {
@@ -128,13 +175,33 @@ impl Ray {
         tooth: usize,
         t: f64,
     ) -> Self {
-        let step = kin.motion().rigid_step(t);
-        let pose = match &step {
-            Some(s) => s.pose,
-            None => kin.motion().pose(t),
-        };
-        let spin = kin.spindle_angle(t).sin_cos();
-        let st = kin.edge_from_pose_sc(&pose, &geo.points[tooth], geo.z, spin.0, spin.1);
+        Self::at_time(kin, geo, tooth, &RayTime::new(kin, t))
+    }
+
+    /// Ray of `tooth` on the prepared height `geo` at the prepared time `time`.
+    #[inline]
+    pub fn at_time<M: ToolMotion>(
+        kin: &ToolKinematics<M>,
+        geo: &HeightGeometry,
+        tooth: usize,
+        time: &RayTime,
+    ) -> Self {
+        Ray {
+            step: time.step,
+            ..Self::at_time_without_step(kin, geo, tooth, time)
+        }
+    }
+
+    /// [`Self::at_time`] with `step` left `None` (for solvers that take the screw from `time`).
+    #[inline]
+    pub(super) fn at_time_without_step<M: ToolMotion>(
+        kin: &ToolKinematics<M>,
+        geo: &HeightGeometry,
+        tooth: usize,
+        time: &RayTime,
+    ) -> Self {
+        let (pose, spin, step) = (&time.pose, time.spin, None);
+        let st = kin.edge_from_pose_sc(pose, &geo.points[tooth], geo.z, spin.0, spin.1);
         let r = st.pos - st.axis_point;
         let radius = r.norm();
         let dir = r * (1.0 / radius);
@@ -309,25 +376,58 @@ pub fn exact_at<M: ToolMotion>(
     t: f64,
     opts: &NewtonOptions,
 ) -> ExactIuct {
-    let ray = Ray::at(kin, geo, tooth, t);
-    let mut best = f64::NEG_INFINITY;
-    let mut cutting_m = 1;
-    let mut iterations = 0;
-    let mut converged = true;
-    for m in 1..=geo.teeth() {
-        let c = crossing_at(kin, geo, &ray, tooth, m, t, opts);
-        iterations += c.iterations;
-        converged &= c.converged;
-        if c.s > best {
-            best = c.s;
-            cutting_m = m;
+    exact_at_time(kin, geo, tooth, &RayTime::new(kin, t), opts)
+}
+
+/// Exact IUCT on a prepared height at a prepared time, eq. (2.2): the K Newton solves of
+/// eq. (2.3) run in lockstep, four previous passes per lane vector (`chip::lanes`), with the same
+/// operations in the same order as [`crossing_at`] in every lane, so the result is bit-identical
+/// to [`reference::exact_at`] (tested in tests/core/chip_models.rs).
+#[inline]
+pub fn exact_at_time<M: ToolMotion>(
+    kin: &ToolKinematics<M>,
+    geo: &HeightGeometry,
+    tooth: usize,
+    time: &RayTime,
+    opts: &NewtonOptions,
+) -> ExactIuct {
+    lanes::exact(kin, geo, tooth, time, opts)
+}
+
+/// The scalar solver, one previous pass after the other: the baseline of the lockstep
+/// [`exact_at_time`] (same values bit for bit; `benches/chip.rs` measures both in one run).
+#[doc(hidden)]
+pub mod reference {
+    use super::*;
+
+    /// Exact IUCT on a prepared height, eq. (2.2), by [`crossing_at`] for m = 1..=K in turn.
+    pub fn exact_at<M: ToolMotion>(
+        kin: &ToolKinematics<M>,
+        geo: &HeightGeometry,
+        tooth: usize,
+        t: f64,
+        opts: &NewtonOptions,
+    ) -> ExactIuct {
+        let ray = Ray::at(kin, geo, tooth, t);
+        let mut best = f64::NEG_INFINITY;
+        let mut cutting_m = 1;
+        let mut iterations = 0;
+        let mut converged = true;
+        for m in 1..=geo.teeth() {
+            let c = crossing_at(kin, geo, &ray, tooth, m, t, opts);
+            iterations += c.iterations;
+            converged &= c.converged;
+            if c.s > best {
+                best = c.s;
+                cutting_m = m;
+            }
         }
-    }
-    ExactIuct {
-        raw: ray.radius - best,
-        radius: ray.radius,
-        cutting_m,
-        iterations,
-        converged,
+        ExactIuct {
+            raw: ray.radius - best,
+            radius: ray.radius,
+            cutting_m,
+            iterations,
+            converged,
+        }
     }
 }

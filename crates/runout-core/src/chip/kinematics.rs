@@ -74,17 +74,17 @@ pub struct RigidStep {
     pub t: f64,
     /// Pose at t_r.
     pub pose: Pose,
-    lo: f64,
-    hi: f64,
+    pub(super) lo: f64,
+    pub(super) hi: f64,
     /// Rodrigues terms of u and e₁ (v ↦ v + sin α·ŵ×v + (1 − cos α)·(ŵ(ŵ·v) − v)), precomputed:
     /// [ŵ×u, ŵ(ŵ·u) − u, ŵ×e₁, ŵ(ŵ·e₁) − e₁].
-    terms: [Vec3; 4],
+    pub(super) terms: [Vec3; 4],
     /// Rotation rate (rad/s).
-    rate: f64,
+    pub(super) rate: f64,
     /// Height of the point C above the tip (mm).
-    pivot: f64,
+    pub(super) pivot: f64,
     /// Velocity of C (mm/s).
-    vc: Vec3,
+    pub(super) vc: Vec3,
 }
 
 impl RigidStep {
@@ -120,7 +120,7 @@ impl RigidStep {
     }
 
     /// Largest rotation (rad) reached incrementally; beyond it [`Self::pose_at`] declines.
-    const MAX_ANGLE: f64 = 0.5;
+    pub(super) const MAX_ANGLE: f64 = 0.5;
 
     /// Whether `t` lies in the interval of this screw (no CL-path junction in between).
     #[inline]
@@ -523,16 +523,7 @@ impl ToolMotion for ClPath {
         self.segment_index(t0) == self.segment_index(t1)
     }
     fn pose(&self, t: f64) -> Pose {
-        let seg = self.find(t);
-        let s = (t - seg.t0) / seg.dt;
-        let (sn, cs) = (s * seg.angle).sin_cos();
-        Pose {
-            p: seg.p + seg.dp * s,
-            u: rotate(&seg.w, sn, cs, &seg.u),
-            e1: rotate(&seg.w, sn, cs, &seg.e1),
-            v: seg.dp / seg.dt,
-            w: seg.w * (seg.angle / seg.dt),
-        }
+        Self::pose_on(self.find(t), t)
     }
     fn rigid_step(&self, t: f64) -> Option<RigidStep> {
         // the first and last segments are extrapolated beyond the path (see `pose`)
@@ -546,7 +537,7 @@ impl ToolMotion for ClPath {
         };
         Some(RigidStep::new(
             t,
-            self.pose(t),
+            Self::pose_on(seg, t),
             lo,
             hi,
             seg.w,
@@ -554,6 +545,22 @@ impl ToolMotion for ClPath {
             0.0,
             seg.dp / seg.dt,
         ))
+    }
+}
+
+impl ClPath {
+    /// Pose at `t` by the formula of segment `seg`.
+    #[inline]
+    fn pose_on(seg: &Segment, t: f64) -> Pose {
+        let s = (t - seg.t0) / seg.dt;
+        let (sn, cs) = (s * seg.angle).sin_cos();
+        Pose {
+            p: seg.p + seg.dp * s,
+            u: rotate(&seg.w, sn, cs, &seg.u),
+            e1: rotate(&seg.w, sn, cs, &seg.e1),
+            v: seg.dp / seg.dt,
+            w: seg.w * (seg.angle / seg.dt),
+        }
     }
 }
 
@@ -1044,36 +1051,42 @@ impl<M: ToolMotion> ToolKinematics<M> {
 /// (measured in `benches/chip.rs`, which prints the libm baseline) at full double accuracy.
 #[inline]
 pub fn small_sin_cos(x: f64) -> (f64, f64) {
-    const S: [f64; 7] = [
-        -1.0 / 6.0,
-        1.0 / 120.0,
-        -1.0 / 5040.0,
-        1.0 / 362_880.0,
-        -1.0 / 39_916_800.0,
-        1.0 / 6_227_020_800.0,
-        -1.0 / 1_307_674_368_000.0,
-    ];
-    const C: [f64; 8] = [
-        -1.0 / 2.0,
-        1.0 / 24.0,
-        -1.0 / 720.0,
-        1.0 / 40_320.0,
-        -1.0 / 3_628_800.0,
-        1.0 / 479_001_600.0,
-        -1.0 / 87_178_291_200.0,
-        1.0 / 20_922_789_888_000.0,
-    ];
     let q = x * x;
-    if q < 0.015625 {
+    if q < SMALL_ANGLE_SQ {
         // |x| ≤ 1/8: degree 9/10 suffice (next terms x¹¹/11! < 3e-18, x¹²/12! < 4e-20)
-        let ps = S[..4].iter().rev().fold(0.0, |acc, c| acc * q + c);
-        let pc = C[..5].iter().rev().fold(0.0, |acc, c| acc * q + c);
+        let ps = SIN_TAYLOR[..4].iter().rev().fold(0.0, |acc, c| acc * q + c);
+        let pc = COS_TAYLOR[..5].iter().rev().fold(0.0, |acc, c| acc * q + c);
         return (x + x * q * ps, 1.0 + q * pc);
     }
     if x.abs() > 0.5 {
         return x.sin_cos();
     }
-    let ps = S.iter().rev().fold(0.0, |acc, c| acc * q + c);
-    let pc = C.iter().rev().fold(0.0, |acc, c| acc * q + c);
+    let ps = SIN_TAYLOR.iter().rev().fold(0.0, |acc, c| acc * q + c);
+    let pc = COS_TAYLOR.iter().rev().fold(0.0, |acc, c| acc * q + c);
     (x + x * q * ps, 1.0 + q * pc)
 }
+
+/// Below this x², [`small_sin_cos`] uses its degree-9/10 branch (|x| < 1/8).
+pub(super) const SMALL_ANGLE_SQ: f64 = 0.015625;
+
+/// Taylor coefficients of (sin x − x)/x³ in x² ([`small_sin_cos`]).
+pub(super) const SIN_TAYLOR: [f64; 7] = [
+    -1.0 / 6.0,
+    1.0 / 120.0,
+    -1.0 / 5040.0,
+    1.0 / 362_880.0,
+    -1.0 / 39_916_800.0,
+    1.0 / 6_227_020_800.0,
+    -1.0 / 1_307_674_368_000.0,
+];
+/// Taylor coefficients of (cos x − 1)/x² in x² ([`small_sin_cos`]).
+pub(super) const COS_TAYLOR: [f64; 8] = [
+    -1.0 / 2.0,
+    1.0 / 24.0,
+    -1.0 / 720.0,
+    1.0 / 40_320.0,
+    -1.0 / 3_628_800.0,
+    1.0 / 479_001_600.0,
+    -1.0 / 87_178_291_200.0,
+    1.0 / 20_922_789_888_000.0,
+];

@@ -11,6 +11,7 @@ pub mod compare;
 pub mod compensation;
 pub mod exact;
 pub mod kinematics;
+mod lanes;
 pub mod lookback;
 mod straight;
 
@@ -23,7 +24,8 @@ pub use compensation::{
     calibration_grid, fit_compensation, fit_compensation_to, CalibrationPoint, CompensationFit,
 };
 pub use exact::{
-    crossing_at, exact_at, exact_iuct, ray_crossing, ExactIuct, NewtonOptions, Ray, RayCrossing,
+    crossing_at, exact_at, exact_at_time, exact_iuct, ray_crossing, ExactIuct, NewtonOptions, Ray,
+    RayCrossing, RayTime,
 };
 pub use kinematics::{
     CircularFeed, ClPath, ClPoint, ConstantSwing, EdgeState, HeightGeometry, JointPath, JointPoint,
