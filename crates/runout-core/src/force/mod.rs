@@ -338,7 +338,7 @@ impl ForceModel {
                         .map(|i| {
                             let x = &acc.own[2 * i * stride..2 * i * stride + len];
                             let y = &acc.own[(2 * i + 1) * stride..(2 * i + 1) * stride + len];
-                            x.iter().zip(y).fold(0.0f64, |p, (x, y)| p.max(x.hypot(*y)))
+                            peaks::max_hypot(x, y)
                         })
                         .collect();
                     let max_chip: Vec<f64> = acc
