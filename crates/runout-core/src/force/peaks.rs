@@ -50,42 +50,17 @@ pub fn tooth_peaks(series: &ForceSeries, cutter: &Cutter, cut: &Cut) -> Vec<Toot
     // of its largest |F_xy| per tooth; merged in sample order keeping the earlier block's peak on
     // a tie: the first sample of the largest value over the series, as one sequential scan.
     let n = series.angle.len().min(series.fx.len()).min(series.fy.len());
+    let arch = pulp::Arch::new();
     (0..n.div_ceil(PEAK_BLOCK))
         .into_par_iter()
         .map(|b| {
-            let mut peaks = blank.clone();
-            // a sample below every tooth's peak cannot raise any: skipped before its owner and
-            // hypot are computed ([`hypot_below`]); the others are taken exactly as before
-            let mut low = f64::NEG_INFINITY;
-            for q in b * PEAK_BLOCK..((b + 1) * PEAK_BLOCK).min(n) {
-                let (x, y) = (series.fx[q], series.fy[q]);
-                if hypot_below(x, y, low) {
-                    continue;
-                }
-                let theta = series.angle[q];
-                // the tooth whose tip entered most recently owns this sample (the first on a tie)
-                let mut owner = 0;
-                let mut best = wrap_tau(theta + tip[0] - st);
-                for (i, &t) in tip.iter().enumerate().skip(1) {
-                    let r = wrap_tau(theta + t - st);
-                    if r.total_cmp(&best).is_lt() {
-                        owner = i;
-                        best = r;
-                    }
-                }
-                let f = x.hypot(y);
-                let p = &mut peaks[owner];
-                if f > p.peak_fxy {
-                    p.peak_fxy = f;
-                    p.angle = wrap_tau(theta);
-                    p.immersion = wrap_tau(theta + tip[owner]);
-                    low = peaks
-                        .iter()
-                        .map(|p| hypot_floor(p.peak_fxy))
-                        .fold(f64::INFINITY, f64::min);
-                }
-            }
-            peaks
+            arch.dispatch(Scan {
+                series,
+                tip: &tip,
+                st,
+                samples: b * PEAK_BLOCK..((b + 1) * PEAK_BLOCK).min(n),
+                blank: &blank,
+            })
         })
         .reduce(
             || blank.clone(),
@@ -96,6 +71,64 @@ pub fn tooth_peaks(series: &ForceSeries, cutter: &Cutter, cut: &Cut) -> Vec<Toot
                     .collect()
             },
         )
+}
+
+/// One block of [`tooth_peaks`] as a [`pulp::WithSimd`] operation, so that the scan is compiled
+/// with the detected instruction set (its `floor` in `wrap_tau` becomes one rounding
+/// instruction instead of a call; the same values, floor is exact).
+struct Scan<'a> {
+    series: &'a ForceSeries,
+    tip: &'a [f64],
+    st: f64,
+    samples: std::ops::Range<usize>,
+    blank: &'a [ToothPeak],
+}
+
+impl pulp::WithSimd for Scan<'_> {
+    type Output = Vec<ToothPeak>;
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Vec<ToothPeak> {
+        let Scan {
+            series,
+            tip,
+            st,
+            samples,
+            blank,
+        } = self;
+        let mut peaks = blank.to_vec();
+        // a sample below every tooth's peak cannot raise any: skipped before its owner and
+        // hypot are computed ([`hypot_below`]); the others are taken exactly as before
+        let mut low = f64::NEG_INFINITY;
+        for q in samples {
+            let (x, y) = (series.fx[q], series.fy[q]);
+            if hypot_below(x, y, low) {
+                continue;
+            }
+            let theta = series.angle[q];
+            // the tooth whose tip entered most recently owns this sample (the first on a tie)
+            let mut owner = 0;
+            let mut best = wrap_tau(theta + tip[0] - st);
+            for (i, &t) in tip.iter().enumerate().skip(1) {
+                let r = wrap_tau(theta + t - st);
+                if r.total_cmp(&best).is_lt() {
+                    owner = i;
+                    best = r;
+                }
+            }
+            let f = x.hypot(y);
+            let p = &mut peaks[owner];
+            if f > p.peak_fxy {
+                p.peak_fxy = f;
+                p.angle = wrap_tau(theta);
+                p.immersion = wrap_tau(theta + tip[owner]);
+                low = peaks
+                    .iter()
+                    .map(|p| hypot_floor(p.peak_fxy))
+                    .fold(f64::INFINITY, f64::min);
+            }
+        }
+        peaks
+    }
 }
 
 /// Samples per parallel block of [`tooth_peaks`].
