@@ -197,6 +197,9 @@ fn end_to_end(c: &mut Criterion) {
         );
     }
     g.finish();
+    if times[0].borrow().is_empty() {
+        return; // filtered out
+    }
     let k = median(&times[0].borrow());
     let e = evals as f64;
     eprintln!(
@@ -205,7 +208,7 @@ fn end_to_end(c: &mut Criterion) {
         k,
         e / k / 1e6
     );
-    if have_bin {
+    if have_bin && !times[1].borrow().is_empty() {
         let p = median(&times[1].borrow());
         eprintln!(
             "end_to_end: runout simulate process {:.3} s = {:.0} M evaluations/s; process / kernel = {:.2}× (target ≤ 1.3×)",

@@ -210,7 +210,7 @@ mod tests {
             300.0f64.next_up(),
             300.0f64.next_down(),
         ];
-        let mut pick = |s: &mut u64| {
+        let pick = |s: &mut u64| {
             let r = lcg(s);
             if r < 0.05 {
                 special[(lcg(s) * special.len() as f64) as usize]
