@@ -14,8 +14,16 @@ example's cut — K 4, Ø10, 30° helix, a_p 2, a_e 2 mm down, 3240 rpm, f_z 0.0
   only the parse and a mean, none of the identification (interpreter start and import excluded).
 
 Prints the medians (s), the throughput (MB/s) and the ratio, and the peak resident memory of
-each (`ru_maxrss` of the child process for runout; for pandas a child process running only the
-read, so the interpreter's own footprint is included as a user would see it).
+each: for runout as GNU `/usr/bin/time -f %M` reports it (not the `ru_maxrss` of a child started
+from Python: Linux carries the peak of the Python process that vfork()s it into the child's
+figure, ≈ 100 MB once pandas is imported, which is what the first version of this script
+printed); for pandas a child process running only the read, so the interpreter's own footprint
+is included as a user would see it.
+
+The identification after the reading (sine fits, harmonic and full-signal fits) costs about the
+same whatever the recording's length, so `identify` is also timed on the first 30 000 lines of
+the same file: the difference gives the ingest rate proper (reading, mapping, the three passes
+of the signal pipeline) apart from that fixed cost.
 
     python3 benches/ingest_vs_pandas.py [--mb 100] [--repeats 5] [--runout PATH] [--dir DIR]
 
@@ -78,12 +86,20 @@ def header_rows(path):
     sys.exit(f"{path}: no `Time,…` column row")
 
 
+GNU_TIME = "/usr/bin/time"
+
+
 def run_timed(cmd, env=None):
-    """Wall time, stdout and peak RSS (KiB) of one child process (`os.wait4`'s own rusage)."""
+    """Wall time, stdout and peak RSS (KiB) of one child process; CPU seconds in `run_timed.cpu`.
+
+    The peak RSS is GNU time's `%M` (the child's own), else `os.wait4`'s, which on Linux also
+    holds this Python process's peak (see the module docs; flagged in the output)."""
     import tempfile
-    with tempfile.TemporaryFile() as out:
+    use_time = os.access(GNU_TIME, os.X_OK)
+    with tempfile.TemporaryFile() as out, tempfile.NamedTemporaryFile("r") as rss:
+        full = [GNU_TIME, "-f", "%M", "-o", rss.name] + cmd if use_time else cmd
         t0 = time.perf_counter()
-        p = subprocess.Popen(cmd, stdout=out, stderr=subprocess.DEVNULL, env=env)
+        p = subprocess.Popen(full, stdout=out, stderr=subprocess.DEVNULL, env=env)
         _, status, usage = os.wait4(p.pid, 0)
         dt = time.perf_counter() - t0
         p.returncode = os.waitstatus_to_exitcode(status)
@@ -91,7 +107,9 @@ def run_timed(cmd, env=None):
             sys.exit(f"{' '.join(cmd)}: exit {p.returncode}")
         out.seek(0)
         run_timed.cpu = usage.ru_utime + usage.ru_stime
-        return dt, out.read().decode(), usage.ru_maxrss
+        peak = int(rss.read().split()[-1]) if use_time else usage.ru_maxrss
+        run_timed.rss_note = "" if use_time else " (includes the Python parent's peak: no /usr/bin/time)"
+        return dt, out.read().decode(), peak
 
 
 def strip(report):
@@ -109,10 +127,12 @@ def main():
     args = ap.parse_args()
     if not os.path.exists(args.runout):
         sys.exit(f"{args.runout}: not found; build it with `cargo build --release -p runout-cli`")
-    try:
-        import pandas as pd
-    except ImportError:
+    # pandas only in the child processes: imported here it would weigh on every child's ru_maxrss
+    probe = subprocess.run([sys.executable, "-c", "import pandas; print(pandas.__version__)"],
+                           capture_output=True, text=True)
+    if probe.returncode != 0:
         sys.exit("needs pandas (pip install pandas)")
+    pd_version = probe.stdout.strip()
 
     os.makedirs(args.dir, exist_ok=True)
     path = os.path.join(args.dir, f"cut_{int(args.mb)}MB.txt")
@@ -124,9 +144,15 @@ def main():
         f.write(CUT_TOML)
     size = os.path.getsize(path)
     skip = header_rows(path)
+    # the same recording's first 30 000 lines: the fixed cost of the identification
+    head = os.path.join(args.dir, "cut_head30k.txt")
+    with open(path, "rb") as f, open(head, "wb") as g:
+        for _, line in zip(range(30_000), f):
+            g.write(line)
+    head_size = os.path.getsize(head)
 
-    def time_runout(binary):
-        cmd = [binary, "identify", path, "--config", toml, "--json", "-"]
+    def time_runout(binary, file=path):
+        cmd = [binary, "identify", file, "--config", toml, "--json", "-"]
         times, peak, report = [], 0, None
         cpu = []
         for _ in range(args.repeats):
@@ -138,7 +164,9 @@ def main():
         return times, peak, report, statistics.median(cpu)
 
     rust, rust_rss, report, rust_cpu = time_runout(args.runout)
+    rust_head = time_runout(args.runout, head)
     base = time_runout(args.baseline) if args.baseline else None
+    base_head = time_runout(args.baseline, head) if args.baseline else None
     pd_times, pd_rss = [], 0
     for _ in range(args.repeats):
         out = subprocess.run(
@@ -150,8 +178,19 @@ def main():
     tr, tp = statistics.median(rust), statistics.median(pd_times)
     mb = size / 1e6
     print(f"file: {path}, {mb:.1f} MB; load average {open('/proc/loadavg').read().split()[:3]}")
+    head_mb = head_size / 1e6
+
+    def ingest(big, small):
+        """Ingest rate (MB/s) from the whole file and the first lines, and the fixed part (s)."""
+        tb, ts = statistics.median(big[0]), statistics.median(small[0])
+        rate = (mb - head_mb) / (tb - ts) if tb > ts else float("inf")
+        return (f"first {head_mb:.1f} MB alone {ts:.3f} s (CPU {small[3]:.3f} s, peak RSS "
+                f"{small[1] / 1024:.1f} MB): ingest rate without that fixed part {rate:.0f} MB/s")
+
     print(f"runout identify (whole job, whole process, median of {len(rust)}): {tr:.3f} s = "
-          f"{mb / tr:.0f} MB/s, CPU {rust_cpu:.3f} s, peak RSS {rust_rss / 1024:.1f} MB")
+          f"{mb / tr:.0f} MB/s, CPU {rust_cpu:.3f} s, peak RSS {rust_rss / 1024:.1f} MB"
+          f"{run_timed.rss_note}")
+    print(f"  {ingest((rust, rust_rss, None, rust_cpu), rust_head)}")
     same = None
     if base is not None:
         # the full-signal fit sums over disks in rayon's run-dependent grouping: compare the
@@ -163,7 +202,8 @@ def main():
         tb = statistics.median(base[0])
         print(f"baseline {args.baseline} (same run): {tb:.3f} s = {mb / tb:.0f} MB/s, CPU {base[3]:.3f} s, "
               f"peak RSS {base[1] / 1024:.1f} MB; identical reports on one thread (provenance aside): {same}")
-    print(f"pandas {pd.__version__} read_csv + mean (median of {len(pd_times)}): {tp:.3f} s = "
+        print(f"  {ingest(base, base_head)}")
+    print(f"pandas {pd_version} read_csv + mean (median of {len(pd_times)}): {tp:.3f} s = "
           f"{mb / tp:.0f} MB/s, peak RSS {pd_rss / 1024:.1f} MB (whole interpreter)")
     print(f"ratio (wall): runout identify takes {tr / tp:.2f}× the pandas read "
           f"({'faster' if tr < tp else 'slower'})")

@@ -76,16 +76,9 @@ impl Cut {
         use crate::limits::{
             positive_at_most, within, MAX_DEPTH_MM, MAX_FZ_MM, MAX_RPM, MIN_DEPTH_MM,
         };
-        positive_at_most("rpm", rpm, MAX_RPM, "rpm", "MAX_RPM")?;
-        positive_at_most("fz_mm", fz_mm, MAX_FZ_MM, "mm", "MAX_FZ_MM")?;
-        within(
-            "ap_mm",
-            ap_mm,
-            MIN_DEPTH_MM,
-            MAX_DEPTH_MM,
-            "mm",
-            "MIN_DEPTH_MM/MAX_DEPTH_MM",
-        )?;
+        positive_at_most("rpm", rpm, MAX_RPM, "rpm")?;
+        positive_at_most("fz_mm", fz_mm, MAX_FZ_MM, "mm")?;
+        within("ap_mm", ap_mm, MIN_DEPTH_MM, MAX_DEPTH_MM, "mm")?;
         Ok(Cut {
             rpm,
             fz: fz_mm,

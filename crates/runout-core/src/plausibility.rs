@@ -374,82 +374,198 @@ pub fn worst(findings: &[Finding]) -> Option<Severity> {
 /// (the result depends on it only through √(1 + r²): ±8 % over that range).
 pub const FORCE_MAGNITUDE_RADIAL_RATIO: f64 = 0.5;
 
+/// Edge coefficients (K_te, K_re) in N/mm that [`force_magnitude`] allows a single recording's
+/// mean force to contain: the upper end of published fits for steels, titanium and aluminium
+/// alloys (K_te 15–40, K_re 25–70 N/mm; Altintas, *Manufacturing Automation*, 2nd ed., §2.4;
+/// Budak, Altintas & Armarego 1996), with margin.
+pub const FORCE_MAGNITUDE_EDGE_N_PER_MM: (f64, f64) = (50.0, 80.0);
+
+/// Axial disks over which [`MeanForceGeometry::new`] integrates a shaped cutter (a cylinder
+/// needs one: every disk has the same immersion).
+const MEAN_FORCE_DISKS: usize = 64;
+
+/// How the mean force of one revolution scales with the cut (docs/methods.md §0; Altintas,
+/// *Manufacturing Automation*, eq. 2.17): summed over axial disks dz at height z above the tip,
+/// with the immersion window [φ_st(z), φ_ex(z)] of the local radius R(z) ([`Cut::immersion_at`]),
+///
+/// F̄_x = K/(2π)·Σ dz·[−K_tc·f_z·(I_sc + r·I_ss) − K_te·I_c − K_re·I_s],
+/// F̄_y = K/(2π)·Σ dz·[ K_tc·f_z·(I_ss − r·I_sc) + K_te·I_s − K_re·I_c]
+///
+/// with I_sc = ∫sin φ cos φ, I_ss = ∫sin²φ, I_c = ∫cos φ, I_s = ∫sin φ over the window
+/// ([`crate::identify::immersion_integrals`]) and r = K_rc/K_tc. `shear` is the first bracket
+/// per unit K_tc·f_z (mm: N per N/mm² per mm of feed), `edge` the second for the
+/// coefficients [`FORCE_MAGNITUDE_EDGE_N_PER_MM`] (N). On a cylinder this is the closed form
+/// K·a_p·f_z/(8π)·K_tc·√(1 + r²)·√(A² + B²), A = [cos 2φ], B = [2φ − sin 2φ].
+///
+/// [`Cut::immersion_at`]: crate::Cut::immersion_at
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeanForceGeometry {
+    /// Mean (F̄_x, F̄_y) per unit K_tc·f_z (mm).
+    pub shear: [f64; 2],
+    /// Mean (F̄_x, F̄_y) of the edge forces [`FORCE_MAGNITUDE_EDGE_N_PER_MM`] (N).
+    pub edge: [f64; 2],
+}
+
+impl MeanForceGeometry {
+    /// The geometry of `cut` with `cutter` (a_p from the tip; the cutter's radius profile
+    /// sets each disk's immersion).
+    ///
+    /// ```
+    /// use runout_core::{Cut, Cutter, MillingMode};
+    /// use runout_core::plausibility::MeanForceGeometry;
+    /// let cutter = Cutter::flat(10.0, 4, 30f64.to_radians()).unwrap();
+    /// let cut = Cut::new(3240.0, 0.05, 2.0).unwrap().radial(2.0, MillingMode::Down, &cutter).unwrap();
+    /// let g = MeanForceGeometry::new(&cutter, &cut);
+    /// // K·a_p/(8π)·√1.25·√(A² + B²) for φ 126.9°–180° (A = 1.28, B = 0.8946): ≈ 0.55576 mm
+    /// assert!((g.shear[0].hypot(g.shear[1]) - 0.55576).abs() < 1e-5);
+    /// ```
+    pub fn new(cutter: &crate::Cutter, cut: &crate::Cut) -> Self {
+        let cylinder = matches!(cutter.profile(), crate::RadiusProfile::Flat);
+        let n = if cylinder { 1 } else { MEAN_FORCE_DISKS };
+        let ap = cut.ap();
+        let dz = ap / n as f64;
+        let k = cutter.teeth() as f64 / (2.0 * std::f64::consts::PI);
+        let r = FORCE_MAGNITUDE_RADIAL_RATIO;
+        let (kte, kre) = FORCE_MAGNITUDE_EDGE_N_PER_MM;
+        let (mut shear, mut edge) = ([0.0; 2], [0.0; 2]);
+        for d in 0..n {
+            let z = (d as f64 + 0.5) * dz;
+            let (st, ex) = cut.immersion_at(cutter, z.min(ap));
+            let [isc, iss, ic, is, _] = crate::identify::immersion_integrals(st, ex);
+            shear[0] += k * dz * (-isc - r * iss);
+            shear[1] += k * dz * (iss - r * isc);
+            edge[0] += k * dz * (-kte * ic - kre * is);
+            edge[1] += k * dz * (kte * is - kre * ic);
+        }
+        MeanForceGeometry { shear, edge }
+    }
+}
+
+/// One recording's mean force for [`force_magnitude`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeanForce {
+    /// Feed per tooth f_z (mm).
+    pub fz_mm: f64,
+    /// Mean (F_x, F_y) over the cut (N).
+    pub fxy_n: [f64; 2],
+}
+
 /// The forces' magnitude against the cut's description (issue 21: a wrong `--diameter-mm`,
-/// teeth or force scale). The mean force over a revolution of the shear forces is
-/// (docs/methods.md §0, with h = f_z·sin φ; Altintas, *Manufacturing Automation*, eq. 2.17)
+/// profile, teeth or force scale): the K_tc that the measured mean forces imply through
+/// [`MeanForceGeometry`], against the 200–8 000 N/mm² published for metals (module docs).
 ///
-/// F̄_x = K·a_p·f_z/(8π)·[K_tc·cos 2φ − K_rc·(2φ − sin 2φ)], F̄_y = K·a_p·f_z/(8π)·[K_tc·(2φ − sin 2φ) + K_rc·cos 2φ]
-/// evaluated from φ_st to φ_ex, so |F̄_xy| = K·a_p·f_z/(8π)·K_tc·√(1 + r²)·√(A² + B²) with
-/// A = [cos 2φ], B = [2φ − sin 2φ] and r = K_rc/K_tc. The measured |F̄_xy| thus implies
-/// K_tc; outside the range published for metals (200–8 000 N/mm², module docs) the description
-/// of the cut contradicts the forces: the immersion (diameter and a_e), the teeth, a_p, f_z, or
-/// the force channels' scale. Edge forces add to |F̄_xy| (the implied K_tc is an upper bound at
-/// small f_z), so only a value outside the range is reported, as a warning.
+/// * Recordings of one geometry at ≥ 2 feeds: the least-squares change of the mean force
+///   vector with f_z, s = Σ(f_z − f̄_z)(F̄ − F̄̄)/Σ(f_z − f̄_z)², gives K_tc = |s|/|shear| free
+///   of the edge forces (they do not depend on f_z).
+/// * One feed: edge forces add to the mean, so the implied K_tc lies between
+///   (|F̄| − |edge|)/(|shear|·f_z) and |F̄|/(|shear|·f_z); only a range entirely outside the
+///   published one is reported.
+///
+/// `subject` names the recordings, `cut` describes the cut in words for the message. A finding
+/// is a warning (the description of the cut contradicts the forces).
 ///
 /// ```
-/// use runout_core::plausibility::force_magnitude;
-/// use std::f64::consts::PI;
-/// // 4 teeth, a_p 3 mm, f_z 0.05 mm, a_e 2 mm of a 10 mm cutter (down milling): φ 126.9°–180°
-/// let (st, ex) = (PI - 0.6f64.acos(), PI);
-/// // about 2 000 N/mm²: |F̄| ≈ 4·3·0.05/(8π)·2000·√1.25·√(A²+B²)
-/// assert!(force_magnitude("a", 100.0, 4, 3.0, 0.05, st, ex, 10.0).is_none());
-/// // the same mean force told a 100 mm cutter: φ_st 163.7°, the implied K_tc is far too large
-/// let st100 = PI - 0.96f64.acos();
-/// assert!(force_magnitude("a", 100.0, 4, 3.0, 0.05, st100, ex, 100.0).is_some());
+/// use runout_core::{Cut, Cutter, MillingMode};
+/// use runout_core::plausibility::{force_magnitude, MeanForce, MeanForceGeometry};
+/// let cutter = Cutter::flat(10.0, 4, 30f64.to_radians()).unwrap();
+/// let cut = Cut::new(3240.0, 0.05, 2.0).unwrap().radial(2.0, MillingMode::Down, &cutter).unwrap();
+/// let g = MeanForceGeometry::new(&cutter, &cut);
+/// // K_tc 2 000 N/mm² at f_z 0.05 and 0.08 mm plus an edge force: plausible
+/// let f = |fz: f64| MeanForce { fz_mm: fz, fxy_n: [2000.0 * fz * g.shear[0] + 30.0,
+///                                                  2000.0 * fz * g.shear[1] - 60.0] };
+/// assert!(force_magnitude("a", "", &g, &[f(0.05), f(0.08)]).is_none());
+/// // the same forces told a 100 mm cutter: K_tc ≈ 20 000 N/mm²
+/// let big = Cutter::flat(100.0, 4, 30f64.to_radians()).unwrap();
+/// let g100 = MeanForceGeometry::new(&big, &cut);
+/// assert!(force_magnitude("a", "", &g100, &[f(0.05), f(0.08)]).is_some());
 /// ```
-#[allow(clippy::too_many_arguments)]
 pub fn force_magnitude(
     subject: &str,
-    mean_fxy_n: f64,
-    teeth: usize,
-    ap_mm: f64,
-    fz_mm: f64,
-    entry_rad: f64,
-    exit_rad: f64,
-    diameter_mm: f64,
+    cut: &str,
+    geometry: &MeanForceGeometry,
+    forces: &[MeanForce],
 ) -> Option<Finding> {
-    let a = (2.0 * exit_rad).cos() - (2.0 * entry_rad).cos();
-    let b = (2.0 * exit_rad - (2.0 * exit_rad).sin()) - (2.0 * entry_rad - (2.0 * entry_rad).sin());
-    let geometry = teeth as f64 * ap_mm * fz_mm / (8.0 * std::f64::consts::PI)
-        * (1.0 + FORCE_MAGNITUDE_RADIAL_RATIO.powi(2)).sqrt()
-        * a.hypot(b);
-    if !(geometry > 0.0 && mean_fxy_n.is_finite() && mean_fxy_n > 0.0) {
+    let shear = geometry.shear[0].hypot(geometry.shear[1]);
+    let ok = |m: &MeanForce| m.fz_mm > 0.0 && m.fxy_n.iter().all(|v| v.is_finite());
+    let forces: Vec<MeanForce> = forces.iter().copied().filter(ok).collect();
+    if shear.is_nan() || shear <= 0.0 || forces.is_empty() {
         return None;
     }
-    let ktc = (mean_fxy_n / geometry).min(f64::MAX);
-    let (lo, hi) = coefficient_range(0, ktc);
-    if (lo..=hi).contains(&ktc) {
-        return None;
-    }
-    // numbers as a user wrote them: plain in the usual range, else with an exponent
-    let g = |v: f64| {
-        if (1e-4..1e6).contains(&v.abs()) {
-            format!("{v}")
-        } else {
-            format!("{v:e}")
-        }
+    let n = forces.len() as f64;
+    let fbar = forces.iter().map(|m| m.fz_mm).sum::<f64>() / n;
+    let sxx: f64 = forces.iter().map(|m| (m.fz_mm - fbar).powi(2)).sum();
+    let (lo, hi) = coefficient_range(0, 0.0);
+    let (low, high, how) = if forces.len() >= 2 && sxx > (1e-3 * fbar).powi(2) * n {
+        let mean = |i: usize| forces.iter().map(|m| m.fxy_n[i]).sum::<f64>() / n;
+        let (mx, my) = (mean(0), mean(1));
+        let sx: f64 = forces
+            .iter()
+            .map(|m| (m.fz_mm - fbar) * (m.fxy_n[0] - mx))
+            .sum();
+        let sy: f64 = forces
+            .iter()
+            .map(|m| (m.fz_mm - fbar) * (m.fxy_n[1] - my))
+            .sum();
+        let k = (sx / sxx).hypot(sy / sxx) / shear;
+        let (f0, f1) = forces.iter().fold((f64::INFINITY, 0.0f64), |(a, b), m| {
+            (a.min(m.fz_mm), b.max(m.fz_mm))
+        });
+        let how = format!(
+            "the change of the mean force |F̄_xy| with f_z from {} to {} mm (free of edge forces)",
+            g(f0),
+            g(f1)
+        );
+        (k, k, how)
+    } else {
+        let m = forces
+            .iter()
+            .map(|m| m.fxy_n[0].hypot(m.fxy_n[1]))
+            .sum::<f64>()
+            / n;
+        let edge = geometry.edge[0].hypot(geometry.edge[1]);
+        let per = shear * fbar;
+        let how = format!(
+            "the mean force |F̄_xy| = {m:.1} N at f_z {} mm (of which edge forces may be up to \
+             {edge:.1} N)",
+            g(fbar)
+        );
+        ((m - edge).max(0.0) / per, m / per, how)
     };
+    if high < lo {
+        return Some(magnitude_finding(subject, cut, high, &how, (lo, hi)));
+    }
+    if low > hi {
+        return Some(magnitude_finding(subject, cut, low, &how, (lo, hi)));
+    }
+    None
+}
+
+/// A number as a user wrote it: plain in the usual range, else with an exponent.
+fn g(v: f64) -> String {
+    if (1e-4..1e6).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+fn magnitude_finding(subject: &str, cut: &str, ktc: f64, how: &str, range: (f64, f64)) -> Finding {
     let implied = if ktc.is_finite() && ktc < 1e9 {
         format!("K_tc ≈ {ktc:.0} N/mm²")
     } else {
         format!("K_tc ≈ {ktc:.1e} N/mm²")
     };
-    Some(Finding {
+    Finding {
         code: "force_magnitude_contradicts_cut",
         subject: subject.into(),
         message: format!(
-            "in {subject} the mean force |F̄_xy| = {mean_fxy_n:.1} N implies a specific cutting \
-             force {implied} for {teeth} teeth, a_p {} mm, f_z {} mm and immersion \
-             {:.1}°–{:.1}° of a {} mm cutter; metals lie in {lo:.0}–{hi:.0} N/mm²",
-            g(ap_mm),
-            g(fz_mm),
-            entry_rad.to_degrees(),
-            exit_rad.to_degrees(),
-            g(diameter_mm)
+            "in {subject} {how} implies a specific cutting force {implied} for {cut}; metals \
+             lie in {:.0}–{:.0} N/mm²",
+            range.0, range.1
         ),
-        hint: "check --diameter-mm and a_e (they set the immersion), --teeth, a_p and f_z, and \
-               the force channels' scale (N per volt, N or kN)"
+        hint: "check --diameter-mm, --profile and a_e (they set the immersion), --teeth, a_p \
+               and f_z, and the force channels' scale (N per volt, N or kN)"
             .into(),
         severity: Severity::Warning,
-    })
+    }
 }

@@ -1,6 +1,8 @@
 //! Parse throughput of the recording reader on a generated multi-channel CSV (issue 3 target:
-//! ≥ 100 MB/s), against a baseline in the same run: the `csv` crate's `ByteRecord` reader with
-//! `str::parse::<f64>` per cell (what a straightforward implementation would do).
+//! ≥ 100 MB/s), against two baselines in the same run: the `csv` crate's `ByteRecord` reader with
+//! `str::parse::<f64>` per cell (what a straightforward implementation would do), and the reader's
+//! own line path before issue 18 (each line copied out of a `BufReader` by `read_until`, split,
+//! cells parsed by the same float parser; kept here as `old_line_copy_path`).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use runout_io::recording::{ReadOptions, RecordingChunk, RecordingReader};
@@ -33,6 +35,116 @@ fn read_all_ours(bytes: &[u8]) -> f64 {
     sum
 }
 
+/// The data loop of the reader before issue 18, reduced to its work: `read_until` copies each
+/// line out of the `BufReader` (64 KiB), the line is split on the delimiter and every cell parsed
+/// with the reader's float parser (the copy below, `old_parse_number`), into 65 536-row chunks.
+fn read_all_old_line_copy_path(bytes: &[u8]) -> f64 {
+    use std::io::{BufRead, Read};
+    let mut src = std::io::BufReader::with_capacity(1 << 16, bytes);
+    let mut buf = Vec::new();
+    src.read_until(b'\n', &mut buf).unwrap(); // header
+    let mut cols: Vec<Vec<f64>> = vec![Vec::new(); 5];
+    let mut sum = 0.0;
+    loop {
+        buf.clear();
+        let n = (&mut src)
+            .take(1 << 20)
+            .read_until(b'\n', &mut buf)
+            .unwrap();
+        if n == 0 {
+            break;
+        }
+        if buf.last() == Some(&b'\n') {
+            buf.pop();
+        }
+        if buf.last() == Some(&b'\r') {
+            buf.pop();
+        }
+        if buf.is_empty() {
+            continue;
+        }
+        for (c, f) in cols.iter_mut().zip(buf.split(|&c| c == b',')) {
+            c.push(old_parse_number(f, false).unwrap());
+        }
+        if cols[0].len() == 65_536 {
+            sum += cols[1].iter().sum::<f64>();
+            cols.iter_mut().for_each(Vec::clear);
+        }
+    }
+    sum + cols[1].iter().sum::<f64>()
+}
+
+/// The reader's float parser before issue 18 (`recording/text.rs`, Clinger's fast path, else
+/// `str::parse`), copied as the baseline.
+fn old_parse_number(cell: &[u8], decimal_comma: bool) -> Option<f64> {
+    const POW10: [f64; 23] = [
+        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+        1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+    ];
+    let mut b = cell;
+    while let [first, rest @ ..] = b {
+        if *first == b' ' || *first == b'\t' {
+            b = rest;
+        } else {
+            break;
+        }
+    }
+    while let [rest @ .., last] = b {
+        if *last == b' ' || *last == b'\t' || *last == b'\r' {
+            b = rest;
+        } else {
+            break;
+        }
+    }
+    if b.len() >= 2 && b[0] == b'"' && b[b.len() - 1] == b'"' {
+        b = &b[1..b.len() - 1];
+    }
+    let n = b.len();
+    let (neg, mut i) = match b.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    let mut mant: u64 = 0;
+    let int_start = i;
+    while i < n {
+        let d = b[i].wrapping_sub(b'0');
+        if d >= 10 {
+            break;
+        }
+        mant = mant.wrapping_mul(10).wrapping_add(u64::from(d));
+        i += 1;
+    }
+    let int_digits = i - int_start;
+    let mut frac_digits = 0;
+    if i < n && (b[i] == b'.' || (decimal_comma && b[i] == b',')) {
+        i += 1;
+        let frac_start = i;
+        while i < n {
+            let d = b[i].wrapping_sub(b'0');
+            if d >= 10 {
+                break;
+            }
+            mant = mant.wrapping_mul(10).wrapping_add(u64::from(d));
+            i += 1;
+        }
+        frac_digits = i - frac_start;
+    }
+    if int_digits + frac_digits == 0 || i < n || int_digits + frac_digits > 19 {
+        // exponents, long mantissas: not in this benchmark's data (the std fallback)
+        return std::str::from_utf8(b).ok()?.parse().ok();
+    }
+    let exp10 = -(frac_digits as i64);
+    let v = if mant == 0 {
+        0.0
+    } else if mant < (1u64 << 53) && exp10 >= -22 {
+        mant as f64 / POW10[(-exp10) as usize]
+    } else {
+        return std::str::from_utf8(b).ok()?.parse().ok();
+    };
+    Some(if neg { -v } else { v })
+}
+
 fn read_all_csv_crate(bytes: &[u8]) -> f64 {
     let mut r = csv::ReaderBuilder::new().from_reader(bytes);
     let mut rec = csv::ByteRecord::new();
@@ -53,11 +165,15 @@ fn read_all_csv_crate(bytes: &[u8]) -> f64 {
 fn bench(c: &mut Criterion) {
     let bytes = generate(400_000);
     assert_eq!(read_all_ours(&bytes), read_all_csv_crate(&bytes));
+    assert_eq!(read_all_ours(&bytes), read_all_old_line_copy_path(&bytes));
     let mut g = c.benchmark_group("parse_csv_5col");
     g.throughput(Throughput::Bytes(bytes.len() as u64));
     g.sample_size(10);
     g.bench_function("runout_reader", |b| {
         b.iter(|| black_box(read_all_ours(black_box(&bytes))))
+    });
+    g.bench_function("old_line_copy_path", |b| {
+        b.iter(|| black_box(read_all_old_line_copy_path(black_box(&bytes))))
     });
     g.bench_function("csv_crate_str_parse", |b| {
         b.iter(|| black_box(read_all_csv_crate(black_box(&bytes))))

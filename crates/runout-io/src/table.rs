@@ -192,9 +192,7 @@ fn read_all(input: TableInput<'_>, delimiter: u8) -> Result<Table, LocatedError>
         return Err(LocatedError::new(
             name,
             0,
-            format!(
-                "{len} bytes: larger than the {max} bytes a table may have (limit MAX_TABLE_BYTES)"
-            ),
+            format!("{len} bytes: larger than the {max} bytes a table may have"),
         ));
     }
     let (mut t, mut rdr) = open(input, delimiter)?;

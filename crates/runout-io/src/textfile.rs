@@ -46,7 +46,7 @@ pub fn read_text(path: &Path) -> Result<String, TextFileError> {
             None,
             format!(
                 "{size} bytes: larger than the {MAX_TABLE_BYTES} bytes a table, config or toolpath \
-                 may have (limit MAX_TABLE_BYTES); split the file"
+                 may have; split the file"
             ),
         )
     };
@@ -90,7 +90,7 @@ pub fn text_from_bytes(file: &str, bytes: Vec<u8>) -> Result<String, TextFileErr
             None,
             format!(
                 "{} bytes: larger than the {MAX_TABLE_BYTES} bytes a table, config or toolpath \
-                 may have (limit MAX_TABLE_BYTES); split the file",
+                 may have; split the file",
                 bytes.len()
             ),
         ));
@@ -117,7 +117,7 @@ fn check_lines(file: &str, bytes: &[u8]) -> Result<(), TextFileError> {
                 line: n + 1,
                 column: None,
                 message: format!(
-                    "line of {} bytes: longer than {MAX_LINE_BYTES} (limit MAX_LINE_BYTES), starting `{}`",
+                    "line of {} bytes: longer than {MAX_LINE_BYTES}, starting `{}`",
                     line.len(),
                     quote(&head)
                 ),

@@ -160,9 +160,7 @@ pub enum UnitError {
     },
     /// Beyond the largest magnitude accepted for the quantity
     /// ([`runout_core::limits::MAX_ABS_QUANTITY`]).
-    #[error(
-        "`{text}` is out of range: expected |value| <= {max:e} {unit} (limit MAX_ABS_QUANTITY)"
-    )]
+    #[error("`{text}` is out of range: expected |value| <= {max:e} {unit}")]
     OutOfRange {
         /// Input text.
         text: String,

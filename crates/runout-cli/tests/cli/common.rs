@@ -66,7 +66,10 @@ pub fn closed_pipe<S: AsRef<std::ffi::OsStr> + std::fmt::Debug>(args: &[S]) {
     #[cfg(not(unix))]
     let killed_by_sigpipe = false;
     assert!(
-        out.status.success() || killed_by_sigpipe || out.status.code() == Some(141),
+        // 3 = finished with a "not identified" answer: when the whole report fits in the pipe's
+        // buffer before the reader closes it, the write succeeds and the job's own status stands
+        // (a race under load, seen with `displacement teeth` on 3 readings of 3 teeth)
+        out.status.success() || killed_by_sigpipe || matches!(out.status.code(), Some(141 | 3)),
         "{args:?}: {:?} {err}",
         out.status
     );

@@ -73,6 +73,49 @@ fn a_wrong_diameter_is_warned_from_the_forces_magnitude() {
     assert!(w.contains("check --diameter-mm"), "{w}");
 }
 
+/// The real PHM 2010 recording (a 6 mm 3-flute **ball-end** cutter at a_p 0.2 mm, a_e 0.125 mm,
+/// f_z 0.0498 mm; ../shared/data/phm2010-c1-slice/SOURCE.md): its mean force of 11.4 N was read as
+/// K_tc ≈ 51 000 N/mm² by a guard that took the nominal radius and no edge forces — a false
+/// alarm naming --diameter-mm on correct input. Described as it is (`--profile ball`: the ball's
+/// local radius at these depths is ≤ 1.08 mm, so the immersion is wider; edge forces up to
+/// K_te 50, K_re 80 N/mm allowed) it is not warned; described as a flat-end cutter it still is,
+/// and the warning names --profile.
+#[test]
+fn a_ball_end_recording_is_not_a_wrong_diameter() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/phm2010-c1-slice/c1_cut158_rows_slice.csv");
+    let data = if data.exists() {
+        data
+    } else {
+        PathBuf::from("/work/shared/data/phm2010-c1-slice/c1_cut158_rows_slice.csv")
+    };
+    let run = |profile: &str| {
+        let o = runout()
+            .arg("identify")
+            .arg(&data)
+            .args(["--teeth", "3", "--diameter-mm", "6", "--helix-deg", "30"])
+            .args(["--profile", profile, "--rpm", "10400", "--fz-mm", "0.0498"])
+            .args(["--ap-mm", "0.2", "--ae-mm", "0.125", "--mode", "down"])
+            .args(["--sample-rate-hz", "50000"])
+            .args(["--axes", "x = force_x_N, y = force_y_N, z = force_z_N"])
+            .args(["--json", "-"])
+            .output()
+            .unwrap();
+        assert!(
+            matches!(o.status.code(), Some(0 | 3)),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let j = json(&o);
+        j["answer"]["warnings"].to_string() + &j["answer"]["reasons"].to_string()
+    };
+    let ball = run("ball");
+    assert!(!ball.contains("implies a specific cutting force"), "{ball}");
+    let flat = run("flat");
+    assert!(flat.contains("implies a specific cutting force"), "{flat}");
+    assert!(flat.contains("--profile"), "{flat}");
+}
+
 /// `plausibility::runout_size` at the command line: the displacement example (ρ ≈ 6 µm) with a
 /// feed per tooth of 5 µm is warned; with 50 µm it is not.
 #[test]

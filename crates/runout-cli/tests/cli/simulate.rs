@@ -97,7 +97,7 @@ fn bad_configs_name_the_key_and_what_was_expected() {
             "ap_mm = 1\nflute_length_mm = 0.5",
             "flute length",
         ),
-        ("revolutions = 1", "revolutions = 1e9", "MAX_REVOLUTIONS"),
+        ("revolutions = 1", "revolutions = 1e9", "(0, 100000]"),
         (
             "step_deg = 1",
             "step_deg = 0.00001",

@@ -54,7 +54,6 @@ impl Sampling {
             revolutions,
             crate::limits::MAX_REVOLUTIONS,
             "revolutions",
-            "MAX_REVOLUTIONS",
         )?;
         positive("step_deg", step_deg)?;
         if step_deg > 90.0 {
@@ -64,13 +63,13 @@ impl Sampling {
                 step_deg,
             ));
         }
-        crate::limits::count("disks", disks, crate::limits::MAX_DISKS, "MAX_DISKS")?;
+        crate::limits::count("disks", disks, crate::limits::MAX_DISKS)?;
         let samples = revolutions * 360.0 / step_deg;
         if samples > Self::MAX_SAMPLES as f64 {
             return Err(ParamError::new(
                 "revolutions",
                 format!(
-                    "at most {} samples in one simulation (revolutions·360/step_deg; limit MAX_SAMPLES)",
+                    "at most {} samples in one simulation (revolutions·360/step_deg)",
                     Self::MAX_SAMPLES
                 ),
                 format!("{revolutions} revolutions at {step_deg}° = {samples:.3e} samples"),

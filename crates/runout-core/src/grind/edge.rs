@@ -69,10 +69,7 @@ fn check_range(z0: f64, z1: f64, n: usize) -> Result<(), ParamError> {
     if !(2..=crate::limits::MAX_POINTS_PER_FLUTE).contains(&n) {
         return Err(ParamError::new(
             "points_per_flute",
-            format!(
-                "an integer in [2, {}] (limit MAX_POINTS_PER_FLUTE)",
-                crate::limits::MAX_POINTS_PER_FLUTE
-            ),
+            format!("an integer in [2, {}]", crate::limits::MAX_POINTS_PER_FLUTE),
             n,
         ));
     }

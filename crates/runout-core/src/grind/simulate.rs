@@ -40,7 +40,6 @@ pub fn uniform_grid(
         "probe points (layers × angles)",
         layers as f64 * angles as f64,
         crate::limits::MAX_PROBE_POINTS as f64,
-        "MAX_PROBE_POINTS",
     )?;
     if u_b.is_nan() || u_a.is_nan() || u_b <= u_a {
         return Err(ParamError::new(

@@ -363,8 +363,7 @@ fn runout_of(s: &ChipCaseSpec, cutter: &Cutter) -> Result<Runout, String> {
 
 fn feed_speed(s: &ChipCaseSpec) -> Result<f64, String> {
     let fz = s.fz_mm.ok_or("fz_mm: required for this motion")?;
-    limits::positive_at_most("fz_mm", fz, limits::MAX_FZ_MM, "mm", "MAX_FZ_MM")
-        .map_err(|e| e.to_string())?;
+    limits::positive_at_most("fz_mm", fz, limits::MAX_FZ_MM, "mm").map_err(|e| e.to_string())?;
     Ok(fz * s.teeth as f64 * s.rpm / 60.0)
 }
 
@@ -464,7 +463,6 @@ pub fn resolve_case(
         "samples_per_rev",
         spec.samples_per_rev,
         limits::MAX_SAMPLES_PER_REV,
-        "MAX_SAMPLES_PER_REV",
     )
     .and_then(|_| {
         limits::within(
@@ -473,7 +471,6 @@ pub fn resolve_case(
             0.0,
             limits::MAX_REVOLUTIONS,
             "(0 = the whole path)",
-            "MAX_REVOLUTIONS",
         )
     })
     .map_err(|e| err(e.to_string()))?;
@@ -502,7 +499,6 @@ pub fn resolve_case(
         ),
         grid,
         limits::MAX_SAMPLES as f64,
-        "MAX_SAMPLES",
     )
     .map_err(|e| err(e.to_string()))?;
     let samples = samples as usize;

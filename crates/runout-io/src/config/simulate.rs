@@ -335,7 +335,6 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
                 -limits::MAX_COEFFICIENT,
                 limits::MAX_COEFFICIENT,
                 "N/mm² (shear) or N/mm (edge)",
-                "MAX_COEFFICIENT",
             )
             .map_err(|e| key_err(s, e))?;
         }
@@ -367,7 +366,6 @@ pub fn resolve_simulate(s: &Settings) -> Result<SimulateCase, ConfigError> {
                 limits::MIN_SIMULATED_REVOLUTIONS,
                 limits::MAX_REVOLUTIONS,
                 "(every tooth's peak needs a full revolution)",
-                "MIN_SIMULATED_REVOLUTIONS",
             )
             .map(|_| sm)
         })
@@ -409,7 +407,6 @@ impl SimulateCase {
             "chip evaluations",
             evaluations,
             limits::MAX_EVALUATIONS,
-            "MAX_EVALUATIONS",
         )
         .and_then(|_| limits::result_size("revolutions", n, 4.0 + k))
         .map_err(err)

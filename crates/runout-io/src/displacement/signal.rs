@@ -275,7 +275,7 @@ fn open<'a>(input: TableInput<'a>, options: &SignalOptions) -> Result<Rows<'a>, 
         if bytes.len() as u64 > max {
             return Err(SignalError::File {
                 file,
-                message: format!("more than {max} bytes in memory (limit MAX_RESULT_BYTES): pass the file by path"),
+                message: format!("more than {max} bytes in memory: pass the file by path"),
             });
         }
         let n = bytes.len() as u64;

@@ -154,7 +154,7 @@ fn lex_word(text: &str, at: usize, end: usize) -> Result<Word, (usize, String)> 
         return Err((
             num_start,
             format!(
-                "word `{letter}`: number `{}` out of range (|value| <= {MAX_WORD_VALUE:e}, limit MAX_COORDINATE_MM·10³)",
+                "word `{letter}`: number `{}` out of range (|value| <= {MAX_WORD_VALUE:e})",
                 quoted()
             ),
         ));

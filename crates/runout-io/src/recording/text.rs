@@ -14,6 +14,7 @@ const POW10: [f64; 23] = [
 ];
 
 /// Trim ASCII blanks and one pair of surrounding double quotes.
+#[inline]
 pub(crate) fn trim_field(mut b: &[u8]) -> &[u8] {
     while let [first, rest @ ..] = b {
         if *first == b' ' || *first == b'\t' {
@@ -42,6 +43,7 @@ pub(crate) fn trim_field(mut b: &[u8]) -> &[u8] {
 /// come from positions, not per-digit counters (issue 18: ≈ 1.6× the per-digit state machine
 /// it replaced). With at most 19 digits the mantissa is exact in a `u64`; Clinger's fast path
 /// then applies as described in the module docs, anything else goes to [`slow_parse`].
+#[inline]
 pub(crate) fn parse_number(cell: &[u8], decimal_comma: bool) -> Option<f64> {
     let b = trim_field(cell);
     let n = b.len();

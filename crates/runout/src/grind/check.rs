@@ -146,12 +146,7 @@ pub fn check(req: &CheckRequest) -> Result<CheckReport> {
     let d = req.bar_diameter_mm;
     let (off, tilt) = (req.offset_um, req.tilt_um_per_mm);
     let sigma = req.noise_um * 1e-3;
-    runout_core::limits::count(
-        "--draws",
-        req.draws,
-        runout_core::limits::MAX_DRAWS,
-        "MAX_DRAWS",
-    )?;
+    runout_core::limits::count("--draws", req.draws, runout_core::limits::MAX_DRAWS)?;
     let [u0, u1] = req.u_range_mm;
     let bar = SimulatedBar::new(
         d / 2.0,
@@ -166,7 +161,6 @@ pub fn check(req: &CheckRequest) -> Result<CheckReport> {
         "evaluations (draws × probe points × edge points)",
         req.draws as f64 * (req.layers * req.angles) as f64 * edge.points.len() as f64,
         runout_core::limits::MAX_EVALUATIONS,
-        "MAX_EVALUATIONS",
     )?;
     let [bil, har] = mean_checks(&bar, &grid, &edge, sigma, req)?;
     let um = |x: f64| x * 1e3;

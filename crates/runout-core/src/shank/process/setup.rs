@@ -135,7 +135,7 @@ impl ShankSetup {
             return Err(p(
                 "sample_rate_hz",
                 &format!(
-                    "at most {} samples per spindle revolution (limit MAX_SAMPLES_PER_REV)",
+                    "at most {} samples per spindle revolution",
                     crate::limits::MAX_SAMPLES_PER_REV
                 ),
                 format!("{:.4e} samples per revolution", self.samples_per_rev()),

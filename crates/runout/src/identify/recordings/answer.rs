@@ -101,21 +101,60 @@ pub(super) fn data_findings(req: &RecordingsRequest, files: &[FileResult]) -> Ve
         if let Some(x) = teeth_rpm(&f.name, k, f.cut.rpm(), f.analysis.scan.tooth_passing.hz) {
             out.push(x);
         }
-        let (st, ex) = f.cut.immersion(&req.cutter);
-        if let Some(x) = plausibility::force_magnitude(
-            &f.name,
-            f.mean_force[0].hypot(f.mean_force[1]),
-            k,
-            f.cut.ap(),
-            f.cut.fz(),
-            st,
-            ex,
-            req.cutter.diameter(),
-        ) {
-            out.push(x);
+    }
+    out.extend(force_magnitude_findings(req, files));
+    out
+}
+
+/// The forces' magnitude against the cut: recordings of one geometry (a_p, engagement) are
+/// judged together, so that several feeds give the shear coefficient free of edge forces
+/// (`plausibility::force_magnitude`).
+fn force_magnitude_findings(req: &RecordingsRequest, files: &[FileResult]) -> Vec<Finding> {
+    let mut groups: Vec<(runout_core::Cut, Vec<&FileResult>)> = Vec::new();
+    for f in files {
+        let same = |c: &runout_core::Cut| {
+            c.ap() == f.cut.ap() && c.immersion(&req.cutter) == f.cut.immersion(&req.cutter)
+        };
+        match groups.iter_mut().find(|(c, _)| same(c)) {
+            Some((_, g)) => g.push(f),
+            None => groups.push((f.cut, vec![f])),
         }
     }
-    out
+    let cutter = &req.cutter;
+    groups
+        .iter()
+        .filter_map(|(cut, group)| {
+            let geometry = plausibility::MeanForceGeometry::new(cutter, cut);
+            let forces: Vec<plausibility::MeanForce> = group
+                .iter()
+                .map(|f| plausibility::MeanForce {
+                    fz_mm: f.cut.fz(),
+                    fxy_n: [f.mean_force[0], f.mean_force[1]],
+                })
+                .collect();
+            let names: Vec<&str> = group.iter().map(|f| f.name.as_str()).collect();
+            let (st, ex) = cut.immersion(cutter);
+            let words = format!(
+                "{} teeth, a_p {} mm and immersion {:.1}°–{:.1}° of a {} mm {} cutter",
+                cutter.teeth(),
+                cut.ap(),
+                st.to_degrees(),
+                ex.to_degrees(),
+                cutter.diameter(),
+                profile_word(cutter.profile()),
+            );
+            plausibility::force_magnitude(&names.join(", "), &words, &geometry, &forces)
+        })
+        .collect()
+}
+
+fn profile_word(p: &runout_core::RadiusProfile) -> &'static str {
+    match p {
+        runout_core::RadiusProfile::Flat => "flat-end",
+        runout_core::RadiusProfile::Ball => "ball-end",
+        runout_core::RadiusProfile::BullNose { .. } => "bull-nose",
+        runout_core::RadiusProfile::Tapered { .. } => "tapered",
+    }
 }
 
 /// The tooth-passing line of the spectrum (`line_hz`) against K·n/60: when the strongest line near
