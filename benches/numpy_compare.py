@@ -19,6 +19,10 @@ time is the whole process). The per-tooth peaks of |F_xy| are compared (they mus
 
 Prints both rates (M evaluations/s), the wall-time ratio and the largest peak difference.
 Needs numpy; builds nothing itself (pass --runout or build `target/release/runout` first).
+
+The kernel alone on this same workload, against the same whole `runout simulate` process in the
+same run (issue 18: "the CLI end to end within 1.3× of the kernel"), is the criterion group
+`cargo bench -p runout-core --bench force_kernel -- end_to_end`, which prints the ratio.
 """
 
 import argparse

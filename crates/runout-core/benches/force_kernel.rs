@@ -15,9 +15,20 @@
 //! a_e 2 mm down, 50 disks, 0.036°) over 10 revolutions (20 M evaluations); target ≥ 600 M
 //! evaluations/s on 2 cores. `identify_sums` is the identification's basis sums with
 //! derivatives (384 samples × 193 disks, ball end mill) against its old loop.
+//!
+//! `end_to_end` (issue 18: "the CLI end to end within 1.3× of the kernel") runs the SAME
+//! workload — that of `benches/numpy_compare.py` at 100 revolutions (200 M evaluations; set
+//! `RUNOUT_E2E_REVOLUTIONS` to change) — through the kernel alone (`ForceModel::simulate`, the
+//! series in memory) and as the whole `runout simulate … --json -` process (start-up, parsing,
+//! simulation, per-tooth peaks, JSON), in the same run, and prints the ratio of the medians.
+//! The process is `target/release/runout` (or `$RUNOUT_BIN`); build it first with
+//! `cargo build --release -p runout-cli` (without it the process half is skipped).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use runout_core::*;
+use std::cell::RefCell;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 fn case() -> (ForceModel, ArcChip, Sampling) {
     case_with(RadiusProfile::Flat)
@@ -72,6 +83,140 @@ fn numpy_case() -> (ForceModel, ArcChip, Sampling) {
         chip,
         sampling,
     )
+}
+
+/// The `runout simulate` arguments of the [`numpy_case`] workload (as `benches/numpy_compare.py`).
+fn numpy_case_args(revolutions: f64) -> Vec<String> {
+    let a = [
+        "simulate",
+        "--teeth",
+        "4",
+        "--diameter-mm",
+        "10",
+        "--helix-deg",
+        "30",
+        "--rpm",
+        "3240",
+        "--fz-mm",
+        "0.08",
+        "--ap-mm",
+        "1",
+        "--ae-mm",
+        "2",
+        "--mode",
+        "down",
+        "--runout-um",
+        "8",
+        "--runout-angle-deg",
+        "0",
+        "--ktc",
+        "1889.2",
+        "--krc",
+        "806.1",
+        "--kac",
+        "291",
+        "--kte",
+        "63.12",
+        "--kre",
+        "113.7",
+        "--kae",
+        "-3.1",
+        "--step-deg",
+        "0.036",
+        "--disks",
+        "50",
+        "--chip-model",
+        "arc",
+        "--json",
+        "-",
+    ];
+    let mut v: Vec<String> = a.iter().map(|s| s.to_string()).collect();
+    v.extend(["--revolutions".into(), revolutions.to_string()]);
+    v
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut v = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The kernel alone and the whole `runout simulate` process on the same workload, same run.
+fn end_to_end(c: &mut Criterion) {
+    let revolutions: f64 = std::env::var("RUNOUT_E2E_REVOLUTIONS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(100.0);
+    let (m, chip, _) = numpy_case();
+    let s = Sampling::new(revolutions, 0.036, 50).unwrap();
+    let evals = (s.samples() * s.disks * m.cutter.teeth()) as u64;
+    let bin = std::env::var_os("RUNOUT_BIN")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/release/runout")
+        });
+    let args = numpy_case_args(revolutions);
+    let mut g = c.benchmark_group("end_to_end");
+    g.throughput(Throughput::Elements(evals));
+    g.sample_size(10);
+    // per-iteration times of the measured samples (warm-up calls included: they are few)
+    let times = [RefCell::new(Vec::new()), RefCell::new(Vec::new())];
+    g.bench_function("kernel", |b| {
+        b.iter_custom(|iters| {
+            let t0 = Instant::now();
+            for _ in 0..iters {
+                std::hint::black_box(m.simulate(&chip, &s));
+            }
+            let d = t0.elapsed();
+            times[0].borrow_mut().push(d.as_secs_f64() / iters as f64);
+            d
+        })
+    });
+    let have_bin = bin.exists();
+    if have_bin {
+        g.bench_function("process", |b| {
+            b.iter_custom(|iters| {
+                let mut d = Duration::ZERO;
+                for _ in 0..iters {
+                    let t0 = Instant::now();
+                    let out = std::process::Command::new(&bin)
+                        .args(&args)
+                        .output()
+                        .expect("run runout");
+                    d += t0.elapsed();
+                    assert!(out.status.success(), "runout simulate failed: {out:?}");
+                }
+                times[1].borrow_mut().push(d.as_secs_f64() / iters as f64);
+                d
+            })
+        });
+    } else {
+        eprintln!(
+            "end_to_end/process skipped: {} not found (cargo build --release -p runout-cli)",
+            bin.display()
+        );
+    }
+    g.finish();
+    if times[0].borrow().is_empty() {
+        return; // filtered out
+    }
+    let k = median(&times[0].borrow());
+    let e = evals as f64;
+    eprintln!(
+        "end_to_end: {:.0} M evaluations; kernel {:.3} s = {:.0} M evaluations/s",
+        e / 1e6,
+        k,
+        e / k / 1e6
+    );
+    if have_bin && !times[1].borrow().is_empty() {
+        let p = median(&times[1].borrow());
+        eprintln!(
+            "end_to_end: runout simulate process {:.3} s = {:.0} M evaluations/s; process / kernel = {:.2}× (target ≤ 1.3×)",
+            p,
+            e / p / 1e6,
+            p / k
+        );
+    }
 }
 
 fn bench(c: &mut Criterion) {
@@ -137,5 +282,5 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+criterion_group!(benches, end_to_end, bench);
 criterion_main!(benches);

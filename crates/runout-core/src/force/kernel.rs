@@ -165,18 +165,26 @@ impl Grid {
             step,
             periodic,
         };
+        g.fill(theta);
+        g
+    }
+
+    /// Refill the grid with new angles, reusing its buffers (a simulation's blocks).
+    pub fn fill(&mut self, theta: impl Iterator<Item = f64>) {
+        self.theta.clear();
+        self.sin.clear();
+        self.cos.clear();
         for t in theta {
             let (s, c) = t.sin_cos();
-            g.theta.push(t);
-            g.sin.push(s);
-            g.cos.push(c);
+            self.theta.push(t);
+            self.sin.push(s);
+            self.cos.push(c);
         }
-        g.len = g.theta.len();
-        let p = padded(g.len);
-        g.theta.resize(p, f64::NAN);
-        g.sin.resize(p, 0.0);
-        g.cos.resize(p, 0.0);
-        g
+        self.len = self.theta.len();
+        let p = padded(self.len);
+        self.theta.resize(p, f64::NAN);
+        self.sin.resize(p, 0.0);
+        self.cos.resize(p, 0.0);
     }
 }
 
@@ -235,6 +243,22 @@ impl Acc {
             chip: vec![0.0; k * stride],
             max_chip: vec![[0.0; L]; k],
         }
+    }
+
+    /// Zero every accumulator for a block of `stride` samples, reusing the buffers (a
+    /// simulation's blocks; the same rows as [`Acc::new`] with `sim_teeth`).
+    pub fn reset_sim(&mut self, stride: usize) {
+        let k = self.max_chip.len();
+        self.stride = stride;
+        for (v, rows) in [
+            (&mut self.force, 4),
+            (&mut self.own, 2 * k),
+            (&mut self.chip, k),
+        ] {
+            v.clear();
+            v.resize(rows * stride, 0.0);
+        }
+        self.max_chip.fill([0.0; L]);
     }
 
     /// Add `other` (same shape) into `self`.

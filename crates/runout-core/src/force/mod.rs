@@ -265,61 +265,89 @@ impl ForceModel {
         let n = sampling.samples();
         let omega = self.cut.omega();
         let arch = pulp::Arch::new();
-        let mut out = vec![[0.0f64; 4]; n];
-        let mut chip_out = vec![0.0f64; n * k];
-        let (max_chip, own_peak) = out
-            .par_chunks_mut(CHUNK)
-            .zip(chip_out.par_chunks_mut(CHUNK * k))
+        // The series' columns, written in place by the blocks (issue 18: no intermediate
+        // row-major buffers and gathers; `vec![0.0; n]` maps zero pages that the blocks fault
+        // in once, by the thread that fills them).
+        let column = || vec![0.0f64; n];
+        let (mut angle, mut time, mut fx, mut fy, mut fz, mut torque) =
+            (column(), column(), column(), column(), column(), column());
+        let mut chip: Vec<Vec<f64>> = (0..k).map(|_| column()).collect();
+        let blocks: Vec<Vec<&mut [f64]>> = {
+            let mut cols: Vec<std::slice::ChunksMut<f64>> = [
+                &mut angle,
+                &mut time,
+                &mut fx,
+                &mut fy,
+                &mut fz,
+                &mut torque,
+            ]
+            .into_iter()
+            .chain(chip.iter_mut())
+            .map(|v| v.chunks_mut(CHUNK))
+            .collect();
+            (0..n.div_ceil(CHUNK))
+                .map(|_| cols.iter_mut().filter_map(|c| c.next()).collect())
+                .collect()
+        };
+        let opts = kernel::Options {
+            edge_in_window: false,
+            np: 0,
+        };
+        let (max_chip, own_peak) = blocks
+            .into_par_iter()
             .enumerate()
-            .map(|(c, (out, chip_out))| {
-                let len = out.len();
-                let grid = kernel::Grid::new(
-                    (0..len).map(|q| sampling.step * (c * CHUNK + q) as f64),
-                    sampling.step,
-                    false,
-                );
-                let mut acc = kernel::Acc::new(kernel::padded(len), GENERAL, 0, Some(k));
-                let opts = kernel::Options {
-                    edge_in_window: false,
-                    np: 0,
-                };
-                kernel::dispatch::<L, GENERAL, true>(
-                    arch,
-                    table,
-                    lanes,
-                    &grid,
-                    0..table.len(),
-                    opts,
-                    Some(sim),
-                    &mut acc,
-                );
-                let stride = acc.stride;
-                let f = &acc.force;
-                for (t, o) in out.iter_mut().enumerate() {
-                    *o = [
-                        f[t],
-                        f[stride + t],
-                        f[2 * stride + t],
-                        f[3 * stride + t] * 1e-3, // N·mm → N·m
-                    ];
-                    for i in 0..k {
-                        chip_out[t * k + i] = acc.chip[i * stride + t];
+            .map_init(
+                // one grid and one set of accumulators per worker, reused block after block
+                || {
+                    (
+                        kernel::Grid::new(std::iter::empty(), sampling.step, false),
+                        kernel::Acc::new(0, GENERAL, 0, Some(k)),
+                    )
+                },
+                |(grid, acc), (c, mut cols)| {
+                    let len = cols[0].len();
+                    grid.fill((0..len).map(|q| sampling.step * (c * CHUNK + q) as f64));
+                    acc.reset_sim(kernel::padded(len));
+                    kernel::dispatch::<L, GENERAL, true>(
+                        arch,
+                        table,
+                        lanes,
+                        grid,
+                        0..table.len(),
+                        opts,
+                        Some(sim),
+                        acc,
+                    );
+                    let stride = acc.stride;
+                    let f = &acc.force;
+                    cols[0].copy_from_slice(&grid.theta[..len]);
+                    for (t, a) in cols[1].iter_mut().zip(&grid.theta[..len]) {
+                        *t = a / omega;
                     }
-                }
-                let own_peak: Vec<f64> = (0..k)
-                    .map(|i| {
-                        let x = &acc.own[2 * i * stride..2 * i * stride + len];
-                        let y = &acc.own[(2 * i + 1) * stride..(2 * i + 1) * stride + len];
-                        x.iter().zip(y).fold(0.0f64, |p, (x, y)| p.max(x.hypot(*y)))
-                    })
-                    .collect();
-                let max_chip: Vec<f64> = acc
-                    .max_chip
-                    .iter()
-                    .map(|v| v.iter().fold(0.0f64, |a, b| a.max(*b)))
-                    .collect();
-                (max_chip, own_peak)
-            })
+                    for r in 0..3 {
+                        cols[2 + r].copy_from_slice(&f[r * stride..r * stride + len]);
+                    }
+                    for (m, v) in cols[5].iter_mut().zip(&f[3 * stride..3 * stride + len]) {
+                        *m = v * 1e-3; // N·mm → N·m
+                    }
+                    for i in 0..k {
+                        cols[6 + i].copy_from_slice(&acc.chip[i * stride..i * stride + len]);
+                    }
+                    let own_peak: Vec<f64> = (0..k)
+                        .map(|i| {
+                            let x = &acc.own[2 * i * stride..2 * i * stride + len];
+                            let y = &acc.own[(2 * i + 1) * stride..(2 * i + 1) * stride + len];
+                            peaks::max_hypot(x, y)
+                        })
+                        .collect();
+                    let max_chip: Vec<f64> = acc
+                        .max_chip
+                        .iter()
+                        .map(|v| v.iter().fold(0.0f64, |a, b| a.max(*b)))
+                        .collect();
+                    (max_chip, own_peak)
+                },
+            )
             .reduce(
                 || (vec![0.0; k], vec![0.0; k]),
                 |a, b| {
@@ -329,25 +357,12 @@ impl ForceModel {
                     )
                 },
             );
-
-        // the series' columns gathered in parallel too (issue 18: serial, they were ~10 % of a
-        // `runout simulate`); the same values
-        let angle: Vec<f64> = (0..n)
-            .into_par_iter()
-            .map(|q| sampling.step * q as f64)
-            .collect();
-        let time = angle.par_iter().map(|a| a / omega).collect();
-        let chip = (0..k)
-            .into_par_iter()
-            .map(|i| (0..n).map(|q| chip_out[q * k + i]).collect())
-            .collect();
-        let column = |c: usize| out.par_iter().map(|v| v[c]).collect();
         ForceSeries {
             time,
-            fx: column(0),
-            fy: column(1),
-            fz: column(2),
-            torque: column(3),
+            fx,
+            fy,
+            fz,
+            torque,
             angle,
             chip,
             max_chip,
