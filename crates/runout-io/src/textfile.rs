@@ -145,7 +145,10 @@ mod tests {
         std::fs::write(&p, "a".repeat(MAX_LINE_BYTES + 10)).unwrap();
         let e = read_text(&p).unwrap_err();
         assert_eq!(e.line(), Some(1));
-        assert!(e.message.contains("MAX_LINE_BYTES"), "{e}");
+        assert!(
+            e.message.contains(&format!("longer than {MAX_LINE_BYTES}")),
+            "{e}"
+        );
         assert!(e.to_string().len() < 300, "{e}");
         let big = dir.path().join("big.csv");
         std::fs::File::create(&big)
@@ -153,7 +156,7 @@ mod tests {
             .set_len(MAX_TABLE_BYTES + 1)
             .unwrap();
         let e = read_text(&big).unwrap_err();
-        assert!(e.message.contains("MAX_TABLE_BYTES"), "{e}");
+        assert!(e.message.contains("split the file"), "{e}");
         let ok = dir.path().join("ok.csv");
         std::fs::write(&ok, "a,b\n1,2\n").unwrap();
         assert_eq!(read_text(&ok).unwrap(), "a,b\n1,2\n");

@@ -195,7 +195,7 @@ fn unknown_records_and_out_of_range_numbers_are_not_dropped_silently() {
     let e = parse_apt("t.apt", &format!("{base}GOTO/1e300,0,5,0,0,1\n")).unwrap_err();
     assert!(e.to_string().contains("t.apt:4") && e.to_string().contains("100000"));
     let e = parse_apt("t.apt", "FEDRAT/MMPM,1e-300\nGOTO/0,0,5\n").unwrap_err();
-    assert!(e.to_string().contains("t.apt:1") && e.to_string().contains("MIN_FEED_MM_MIN"));
+    assert!(e.to_string().contains("t.apt:1") && e.to_string().contains("[0.001, 1000000] mm/min"));
     let e = parse_cl_csv("p.csv", "0,0,0,0,0,1,600\n1e9,0,0,0,0,1\n").unwrap_err();
     assert!(e.to_string().contains("p.csv:2"), "{e}");
 }
