@@ -39,6 +39,7 @@ use crate::coefficients::CuttingCoefficients;
 use crate::fit::linear_lsq;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
+use rayon::prelude::*;
 use realfft::RealFftPlanner;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -775,9 +776,7 @@ fn scan_modes(p: &mut HarmonicProblem<'_>, which: &[usize], teeth: usize, per_ax
         }
     };
     let scan = |p: &mut HarmonicProblem<'_>, ms: &[usize], mut best: (f64, f64, f64)| {
-        for &(f, z) in &grid {
-            set(p, ms, f, z);
-            let c = p.profile_cost();
+        for (&(f, z), &c) in grid.iter().zip(&grid_costs(p, ms, &grid, &set)) {
             if c < best.0 {
                 best = (c, f, z);
             }
@@ -808,6 +807,56 @@ fn scan_modes(p: &mut HarmonicProblem<'_>, which: &[usize], teeth: usize, per_ax
     }
     let end = p.profile_cost();
     improved(p, end)
+}
+
+/// Profile cost at each grid point (f_n, ζ) of the modes `ms`, in grid order, and p left as
+/// the serial loop `for (f, z) in grid { set(p, ms, f, z); p.profile_cost() }` leaves it: the
+/// modes at the last point and the coefficients of the last successful linear solve. Each
+/// point's cost depends on the modes, runout and angles only (the coefficients are solved
+/// afresh), so the points are evaluated in parallel (rayon, one clone of p per task) and the
+/// costs come back in grid order: the same numbers, bit for bit, at any thread count.
+fn grid_costs(
+    p: &mut HarmonicProblem<'_>,
+    ms: &[usize],
+    grid: &[(f64, f64)],
+    set: &(impl Fn(&mut HarmonicProblem<'_>, &[usize], f64, f64) + Sync),
+) -> Vec<f64> {
+    if rayon::current_num_threads() <= 1 || grid.len() < 2 {
+        return grid
+            .iter()
+            .map(|&(f, z)| {
+                set(p, ms, f, z);
+                p.profile_cost()
+            })
+            .collect();
+    }
+    let (c0, nk) = (p.coef_start(), p.coef_idx.len());
+    let shared: &HarmonicProblem<'_> = p;
+    let evaluated: Vec<(f64, Option<Vec<f64>>)> = grid
+        .par_iter()
+        .map_init(
+            || shared.clone(),
+            |q, &(f, z)| {
+                set(q, ms, f, z);
+                match q.linear_coefficients() {
+                    Ok(()) => {
+                        let c = q.residual_vec().iter().map(|r| r * r).sum();
+                        (c, Some((0..nk).map(|i| q.x[c0 + i]).collect()))
+                    }
+                    Err(_) => (f64::INFINITY, None),
+                }
+            },
+        )
+        .collect();
+    if let Some(&(f, z)) = grid.last() {
+        set(p, ms, f, z);
+    }
+    if let Some(kc) = evaluated.iter().rev().find_map(|(_, k)| k.as_ref()) {
+        for (i, v) in kc.iter().enumerate() {
+            p.x[c0 + i] = *v;
+        }
+    }
+    evaluated.into_iter().map(|(c, _)| c).collect()
 }
 
 /// Basis harmonics of the rigid model at runout parameters (e [, τ]) already evaluated: the

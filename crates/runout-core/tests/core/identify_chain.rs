@@ -420,3 +420,28 @@ fn per_recording_runout_is_consistent_across_feeds() {
     );
     assert!(lspread <= 5.0, "λ spread {lspread:.2}°");
 }
+
+/// The mode scan evaluates its grid in parallel (rayon): the fit must be the same, bit for bit,
+/// on one thread and on several (every float compared through its shortest round-trip `Debug`
+/// form, so equal strings mean equal bits). One axial disk: the model's disk sums are split by
+/// thread count (`model` module), which is why the CLI snapshots pin one thread; with a single
+/// disk nothing else depends on it, so a difference here could only come from the scan.
+#[test]
+fn fitted_modes_fit_is_identical_at_any_thread_count() {
+    let s = two_flute();
+    let cases = resonant_set(&s);
+    let options = FullSignalOptions {
+        disks: Some(1),
+        ..chain_options(&s, fitted_modes(), true)
+    };
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| format!("{:?}", full_signal_fit(&cases, &options).unwrap()))
+    };
+    let one = run(1);
+    assert_eq!(one, run(2), "1 vs 2 threads");
+    assert_eq!(one, run(3), "1 vs 3 threads");
+}
