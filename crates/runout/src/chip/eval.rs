@@ -4,7 +4,9 @@ use super::{case_inputs, read_cases, select};
 use crate::job::{Report, Source};
 use anyhow::{bail, Result};
 use runout_core::chip::compare::equivalent_values;
-use runout_core::chip::{arc_at, closed_forms_at, exact_at, EquivalentParams, NewtonOptions};
+use runout_core::chip::{
+    arc_at, closed_forms_at, exact_at_time, EquivalentParams, NewtonOptions, RayTime,
+};
 use runout_io::config::chip::ChipCase;
 use schemars::JsonSchema;
 use serde::Serialize;
@@ -88,6 +90,8 @@ fn eval_model(case: &ChipCase, model: ChipModel) -> Result<Vec<f64>> {
     }
     let opts = NewtonOptions::default();
     let mut geo: Option<runout_core::chip::HeightGeometry> = None;
+    // the pose, screw and spindle angle of a time, shared by its teeth and heights
+    let mut time: Option<RayTime> = None;
     let mut out = Vec::with_capacity(case.points.len());
     for q in &case.points {
         if geo.as_ref().is_none_or(|g| g.z != q.z) {
@@ -96,7 +100,10 @@ fn eval_model(case: &ChipCase, model: ChipModel) -> Result<Vec<f64>> {
         let g = geo.as_ref().expect("set above");
         let h = match model {
             ChipModel::Exact => {
-                let e = exact_at(kin, g, q.tooth, q.t, &opts);
+                if time.as_ref().is_none_or(|r| r.t != q.t) {
+                    time = Some(RayTime::new(kin, q.t));
+                }
+                let e = exact_at_time(kin, g, q.tooth, time.as_ref().expect("set above"), &opts);
                 if !e.converged {
                     bail!(
                         "exact solver did not converge (tooth {}, z {} mm, t {} s)",
