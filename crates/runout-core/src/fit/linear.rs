@@ -164,14 +164,36 @@ pub fn linear_lsq(what: &str, x: &DMatrix<f64>, y: &DVector<f64>) -> Result<Line
         return Err(FitError::too_few(what, format!("{p} observations"), n));
     }
     let lsq = LinearLsq::new(x.clone());
-    let (smax, smin) = (lsq.smax(), lsq.smin());
+    check_rank(what, lsq.smax(), lsq.smin())?;
+    lsq.solve(y, 0.0).map_err(|e| FitError::singular(what, e))
+}
+
+/// The rank test of [`linear_lsq`]: relative singular value above 1e-12.
+fn check_rank(what: &str, smax: f64, smin: f64) -> Result<(), FitError> {
     if smax.is_nan() || smax <= 0.0 || smin <= 1e-12 * smax {
         return Err(FitError::singular(
             what,
             format!("design matrix rank deficient (singular values {smin:.3e} .. {smax:.3e})"),
         ));
     }
-    lsq.solve(y, 0.0).map_err(|e| FitError::singular(what, e))
+    Ok(())
+}
+
+/// β̂ of [`linear_lsq`] only (the same SVD, checks and errors, so the same values), without the
+/// residuals, covariance and condition number: for the inner loops of profile fits that need
+/// the coefficients alone.
+pub fn linear_lsq_beta(
+    what: &str,
+    x: DMatrix<f64>,
+    y: &DVector<f64>,
+) -> Result<DVector<f64>, FitError> {
+    let (n, p) = x.shape();
+    if n < p {
+        return Err(FitError::too_few(what, format!("{p} observations"), n));
+    }
+    let svd = x.svd(true, true);
+    check_rank(what, svd.singular_values.max(), svd.singular_values.min())?;
+    svd.solve(y, 0.0).map_err(|e| FitError::singular(what, e))
 }
 
 /// Coefficient of determination R² = 1 − RSS/Σ(y − ȳ)² (1 when y is constant and fitted exactly).

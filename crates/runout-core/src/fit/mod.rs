@@ -9,5 +9,7 @@ pub mod linear;
 pub mod offset_tilt;
 
 pub use harmonic::{fourier_coefficient, HarmonicFit, HarmonicSums};
-pub use linear::{fit_line, linear_lsq, r_squared, FitError, LinearFit, LinearLsq, Regression};
+pub use linear::{
+    fit_line, linear_lsq, linear_lsq_beta, r_squared, FitError, LinearFit, LinearLsq, Regression,
+};
 pub use offset_tilt::{fit_offset_tilt, LineNoise, OffsetTiltFit};

@@ -36,13 +36,14 @@ use super::sine_fit::Estimate;
 use super::waveform::{FrameAxis, WaveformCase};
 use crate::chain::{AxisChain, Complex64, MeasuringChain, SensorMode};
 use crate::coefficients::CuttingCoefficients;
-use crate::fit::linear_lsq;
+use crate::fit::linear_lsq_beta;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
 use rayon::prelude::*;
 use realfft::RealFftPlanner;
 use serde::Serialize;
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// Oversampling L of the model grid: the rigid model is evaluated at L·N angles per revolution,
 /// so that the chain acts on its true harmonics up to L·N/2 before they are folded by the
@@ -127,6 +128,38 @@ struct CaseData {
     /// Weight per component (RMS standard error, or 1 N).
     weight: Vec<f64>,
     free_angle: Option<usize>,
+}
+
+/// Rigid-model harmonic k of the six coefficient-gradient columns (K order) for axis, from the
+/// basis harmonics `b` ([r][k]) of one case.
+fn gradient_harmonic(b: &[Vec<Complex64>], axis: FrameAxis, k: usize) -> [Complex64; 6] {
+    let mut re = [0.0; NB];
+    let mut im = [0.0; NB];
+    for r in 0..NB {
+        re[r] = b[r][k].re;
+        im[r] = b[r][k].im;
+    }
+    let gr = coefficient_gradient(axis, &re);
+    let gi = coefficient_gradient(axis, &im);
+    std::array::from_fn(|i| Complex64::new(gr[i], gi[i]))
+}
+
+/// What the design matrix, the residuals and the chain columns read, tabulated once per
+/// evaluation of the parameters ([`HarmonicProblem::tables`]); indices [case][component][m] at
+/// the folded true harmonics m (zero where no row folds m). The parts that do not depend on the
+/// modes are shared (`Arc`) with the tables of a mode scan's candidates
+/// ([`HarmonicProblem::with_modes`]).
+struct Tables {
+    /// Per case: the harmonics m that some fitted row folds.
+    used: Arc<Vec<Vec<bool>>>,
+    /// Per case with a free angle: e^{imδ}.
+    polar: Arc<Vec<Option<Vec<Complex64>>>>,
+    /// The chain factor H(m·f_rev)·e^{imδ}.
+    h: Vec<Vec<Vec<Complex64>>>,
+    /// The six coefficient-gradient harmonics of the rigid model.
+    g: Arc<Vec<Vec<Vec<[Complex64; 6]>>>>,
+    /// The measured rows ([`HarmonicProblem::measured_rows`]).
+    y: Arc<DVector<f64>>,
 }
 
 #[derive(Clone)]
@@ -291,9 +324,13 @@ impl HarmonicProblem<'_> {
         }
     }
     fn runout(&self) -> ([f64; 2], [f64; 2]) {
-        let e = [self.x[0] * 1e-3, self.x[1] * 1e-3];
+        self.runout_of(&self.x)
+    }
+    /// Runout offset (mm) and tilt (mm/mm) of parameters `x`.
+    fn runout_of(&self, x: &DVector<f64>) -> ([f64; 2], [f64; 2]) {
+        let e = [x[0] * 1e-3, x[1] * 1e-3];
         let t = if self.fit_tilt {
-            [self.x[2] * 1e-3, self.x[3] * 1e-3]
+            [x[2] * 1e-3, x[3] * 1e-3]
         } else {
             [0.0; 2]
         };
@@ -334,12 +371,16 @@ impl HarmonicProblem<'_> {
     /// Basis sums and their harmonics at the current runout.
     fn recompute(&mut self) {
         let (e, t) = self.runout();
-        self.basis = (0..self.models.len())
+        self.basis = self.basis_at(e, t);
+    }
+    /// Basis harmonics of every case at runout offset `e` (mm) and tilt `t` (mm/mm).
+    fn basis_at(&self, e: [f64; 2], t: [f64; 2]) -> Vec<Vec<Vec<Complex64>>> {
+        (0..self.models.len())
             .map(|c| {
                 let s = self.models[c].base_sums(e, t);
                 self.basis_harmonics(c, &s)
             })
-            .collect();
+            .collect()
     }
     /// Harmonics 0..=L·N/2 of the [`NB`] basis sums on the oversampled grid, scaled by 1/L so
     /// that they compare with an N-point DFT. On a cylinder only rows 0–5 are transformed (rows
@@ -385,14 +426,19 @@ impl HarmonicProblem<'_> {
         sum * d.interp[k]
     }
     /// [`HarmonicProblem::fold`] of the six coefficient-gradient columns at once (the same sums
-    /// in the same order: identical values, with H and the gradient evaluated once per m).
-    fn fold_gradient(&self, c: usize, axis: FrameAxis, k: usize) -> [Complex64; 6] {
+    /// in the same order: identical values), H and the gradient read from the tables `t`.
+    fn fold_gradient(
+        &self,
+        c: usize,
+        k: usize,
+        h: &[Complex64],
+        g: &[[Complex64; 6]],
+    ) -> [Complex64; 6] {
         let d = &self.data[c];
         let top = self.oversample * d.n / 2;
         let mut sum = [Complex64::new(0.0, 0.0); 6];
         let mut add = |m: usize, conj: bool| {
-            let h = self.factor(c, axis, m);
-            let g = self.gradient_harmonic(c, axis, m);
+            let (h, g) = (h[m], &g[m]);
             for i in 0..6 {
                 let v = h * g[i];
                 sum[i] += if conj { v.conj() } else { v };
@@ -410,14 +456,143 @@ impl HarmonicProblem<'_> {
         }
         sum.map(|v| v * d.interp[k])
     }
+    /// The true harmonics m (0..=L·N/2) of case c that the fitted rows fold
+    /// ([`HarmonicProblem::fold`] over the rows' k).
+    fn folded_harmonics(&self, c: usize) -> Vec<bool> {
+        let d = &self.data[c];
+        let top = self.oversample * d.n / 2;
+        let mut used = vec![false; top + 1];
+        for k in 0..=d.kmax {
+            if self.tooth_harmonics_only.is_some_and(|t| k % t != 0) {
+                continue;
+            }
+            let mut m = k;
+            while m <= top {
+                used[m] = true;
+                m += d.n;
+            }
+            let mut m = d.n;
+            while m >= k && m - k <= top {
+                used[m - k] = true;
+                m += d.n;
+            }
+        }
+        used
+    }
+    /// The chain factor and the coefficient-gradient harmonics of every component at every
+    /// folded harmonic m, and the measured rows, computed once per evaluation of the current
+    /// parameters (the design matrix, the residuals and the chain columns all read them; the
+    /// same values as computing them where used).
+    fn tables(&self) -> Tables {
+        self.tables_for(&self.basis)
+    }
+    /// [`HarmonicProblem::tables`] with the basis harmonics `basis` (of another runout).
+    fn tables_for(&self, basis: &[Vec<Vec<Complex64>>]) -> Tables {
+        let zero = Complex64::new(0.0, 0.0);
+        let used: Vec<Vec<bool>> = (0..self.data.len())
+            .map(|c| self.folded_harmonics(c))
+            .collect();
+        // e^{imδ}: one per harmonic, shared by the components
+        let polar: Vec<Option<Vec<Complex64>>> = (0..self.data.len())
+            .map(|c| {
+                self.data[c].free_angle.map(|i| {
+                    let delta = self.x[self.angle_start() + i];
+                    used[c]
+                        .iter()
+                        .enumerate()
+                        .map(|(m, &u)| {
+                            if u {
+                                Complex64::from_polar(1.0, m as f64 * delta)
+                            } else {
+                                zero
+                            }
+                        })
+                        .collect()
+                })
+            })
+            .collect();
+        let g = (0..self.data.len())
+            .map(|c| {
+                self.cases[c]
+                    .waveform
+                    .components
+                    .iter()
+                    .map(|comp| {
+                        let mut g = vec![[zero; 6]; used[c].len()];
+                        for (m, &u) in used[c].iter().enumerate() {
+                            if u {
+                                g[m] = gradient_harmonic(&basis[c], comp.axis, m);
+                            }
+                        }
+                        g
+                    })
+                    .collect()
+            })
+            .collect();
+        let (y, _) = self.measured_rows();
+        let (used, polar) = (Arc::new(used), Arc::new(polar));
+        Tables {
+            h: self.chain_factors(&used, &polar),
+            used,
+            polar,
+            g: Arc::new(g),
+            y: Arc::new(DVector::from_vec(y)),
+        }
+    }
+    /// `t` with the chain factors of the current modes: valid for a candidate that changed the
+    /// modes only (not the runout, the angles, the chain's other parts or the rows).
+    fn with_modes(&self, t: &Tables) -> Tables {
+        Tables {
+            h: self.chain_factors(&t.used, &t.polar),
+            used: Arc::clone(&t.used),
+            polar: Arc::clone(&t.polar),
+            g: Arc::clone(&t.g),
+            y: Arc::clone(&t.y),
+        }
+    }
+    /// The chain factor [`HarmonicProblem::factor_with`] of every component at the folded
+    /// harmonics `used`.
+    fn chain_factors(
+        &self,
+        used: &[Vec<bool>],
+        polar: &[Option<Vec<Complex64>>],
+    ) -> Vec<Vec<Vec<Complex64>>> {
+        let modes: Vec<SensorMode> = (0..self.mode_axes.len()).map(|m| self.mode(m)).collect();
+        (0..self.data.len())
+            .map(|c| {
+                self.cases[c]
+                    .waveform
+                    .components
+                    .iter()
+                    .map(|comp| {
+                        let mut h = vec![Complex64::new(0.0, 0.0); used[c].len()];
+                        for (m, &u) in used[c].iter().enumerate() {
+                            if u {
+                                h[m] =
+                                    self.factor_with(c, comp.axis, m, polar[c].as_deref(), &modes);
+                            }
+                        }
+                        h
+                    })
+                    .collect()
+            })
+            .collect()
+    }
     /// H(m·f_rev)·e^{imδ} of case c, axis, true harmonic m (only e^{imδ} for the rigid
-    /// comparison). A measured FRF is held at its last value above its range.
-    fn factor(&self, c: usize, axis: FrameAxis, k: usize) -> Complex64 {
+    /// comparison). A measured FRF is held at its last value above its range. `polar` holds
+    /// e^{imδ} per m when the case has a free angle, `modes` the current fitted modes.
+    fn factor_with(
+        &self,
+        c: usize,
+        axis: FrameAxis,
+        k: usize,
+        polar: Option<&[Complex64]>,
+        modes: &[SensorMode],
+    ) -> Complex64 {
         let d = &self.data[c];
         let mut h = Complex64::new(1.0, 0.0);
-        if let Some(i) = d.free_angle {
-            let delta = self.x[self.angle_start() + i];
-            h *= Complex64::from_polar(1.0, k as f64 * delta);
+        if let Some(p) = polar {
+            h *= p[k];
         }
         if self.rigid {
             return h;
@@ -427,34 +602,18 @@ impl HarmonicProblem<'_> {
             h *= chain.axis(axis).response_clamped(f);
         }
         if let Some(m) = self.mode_axes.iter().position(|&a| a == axis) {
-            let mode = self.mode(m);
+            let mode = &modes[m];
             h *= Complex64::new(1.0 - mode.gain, 0.0) + mode.unit_response(f) * mode.gain;
         }
         h
     }
-    /// Rigid-model harmonic of the coefficient-gradient column i (K order) for axis.
-    fn gradient_harmonic(&self, c: usize, axis: FrameAxis, k: usize) -> [Complex64; 6] {
-        let b = &self.basis[c];
-        let mut re = [0.0; NB];
-        let mut im = [0.0; NB];
-        for r in 0..NB {
-            re[r] = b[r][k].re;
-            im[r] = b[r][k].im;
-        }
-        let gr = coefficient_gradient(axis, &re);
-        let gi = coefficient_gradient(axis, &im);
-        std::array::from_fn(|i| Complex64::new(gr[i], gi[i]))
-    }
-    /// Rigid-model harmonic m (true, oversampled) for axis.
-    fn model_harmonic(&self, c: usize, axis: FrameAxis, m: usize, kc: &[f64; 6]) -> Complex64 {
-        let g = self.gradient_harmonic(c, axis, m);
-        (0..6).map(|i| g[i] * kc[i]).sum()
-    }
-    /// Measured model harmonic k: chain and angle shift on the true harmonics, then sampling.
-    fn measured_model(&self, c: usize, axis: FrameAxis, k: usize, kc: &[f64; 6]) -> Complex64 {
-        self.fold(c, k, |m| {
-            self.factor(c, axis, m) * self.model_harmonic(c, axis, m, kc)
-        })
+    /// Chain and angle shift on the rigid-model harmonics, H(m)·Σ_i g_i(m)·K_i, at every folded
+    /// harmonic m of the component's tables `t`.
+    fn chained_model(h: &[Complex64], g: &[[Complex64; 6]], kc: &[f64; 6]) -> Vec<Complex64> {
+        h.iter()
+            .zip(g)
+            .map(|(h, g)| *h * (0..6).map(|i| g[i] * kc[i]).sum::<Complex64>())
+            .collect()
     }
     fn n_residuals(&self) -> usize {
         let mut n = 0;
@@ -485,14 +644,30 @@ impl HarmonicProblem<'_> {
         }
     }
     fn residual_vec(&self) -> Vec<f64> {
-        let kc = self.coefficients().to_array();
+        self.residual_vec_with(&self.tables())
+    }
+    /// Residuals with the tables of the current parameters ([`HarmonicProblem::tables`]).
+    fn residual_vec_with(&self, tables: &Tables) -> Vec<f64> {
+        let y = Self::chained_models(tables, &self.coefficients().to_array());
         let mut out = Vec::with_capacity(self.n_residuals());
         self.rows(|c, comp, k, s| {
-            let axis = self.cases[c].waveform.components[comp].axis;
-            let y = self.measured_model(c, axis, k, &kc);
-            Self::push(&mut out, y - self.data[c].measured[comp][k], k, s);
+            let ym = &y[c][comp];
+            let v = self.fold(c, k, |m| ym[m]);
+            Self::push(&mut out, v - self.data[c].measured[comp][k], k, s);
         });
         out
+    }
+    /// [`HarmonicProblem::chained_model`] of every component: [case][component][m].
+    fn chained_models(t: &Tables, kc: &[f64; 6]) -> Vec<Vec<Vec<Complex64>>> {
+        t.h.iter()
+            .zip(t.g.iter())
+            .map(|(hc, gc)| {
+                hc.iter()
+                    .zip(gc)
+                    .map(|(h, g)| Self::chained_model(h, g, kc))
+                    .collect()
+            })
+            .collect()
     }
     /// Measured rows (for R²) and the per-row "mean" part (k = 0 rows).
     fn measured_rows(&self) -> (Vec<f64>, Vec<bool>) {
@@ -504,14 +679,14 @@ impl HarmonicProblem<'_> {
         });
         (out, dc)
     }
-    /// Design matrix of the coefficients (chain included) and the measured rows.
-    fn coefficient_design(&self) -> DMatrix<f64> {
+    /// Design matrix of the coefficients (chain included), from the tables of the current
+    /// parameters.
+    fn coefficient_design(&self, tables: &Tables) -> DMatrix<f64> {
         let n = self.n_residuals();
         let mut x = DMatrix::zeros(n, self.coef_idx.len());
         let mut row = 0;
         self.rows(|c, comp, k, s| {
-            let axis = self.cases[c].waveform.components[comp].axis;
-            let folded = self.fold_gradient(c, axis, k);
+            let folded = self.fold_gradient(c, k, &tables.h[c][comp], &tables.g[c][comp]);
             for (j, &i) in self.coef_idx.iter().enumerate() {
                 let v = folded[i];
                 x[(row, j)] = v.re * s;
@@ -527,25 +702,38 @@ impl HarmonicProblem<'_> {
         if self.coef_idx.is_empty() {
             return Ok(());
         }
-        let x = self.coefficient_design();
-        let (y, _) = self.measured_rows();
-        let fit = linear_lsq("coefficients", &x, &DVector::from_vec(y))?;
+        let tables = self.tables();
+        self.linear_coefficients_with(&tables)
+    }
+    /// The coefficients solved linearly, with the tables of the current parameters (which do
+    /// not depend on the coefficients: they stay valid after the solve).
+    fn linear_coefficients_with(&mut self, tables: &Tables) -> Result<(), IdentifyError> {
+        if self.coef_idx.is_empty() {
+            return Ok(());
+        }
+        let x = self.coefficient_design(tables);
+        let beta = linear_lsq_beta("coefficients", x, &tables.y)?;
         let c0 = self.coef_start();
         for c in 0..self.coef_idx.len() {
-            self.x[c0 + c] = fit.beta[c];
+            self.x[c0 + c] = beta[c];
         }
         Ok(())
     }
     fn profile_cost(&mut self) -> f64 {
-        match self.linear_coefficients() {
-            Ok(()) => self.residual_vec().iter().map(|r| r * r).sum(),
+        let tables = self.tables();
+        self.profile_cost_with(&tables)
+    }
+    /// [`HarmonicProblem::profile_cost`] with the tables of the current parameters.
+    fn profile_cost_with(&mut self, tables: &Tables) -> f64 {
+        match self.linear_coefficients_with(&tables) {
+            Ok(()) => self.residual_vec_with(tables).iter().map(|r| r * r).sum(),
             Err(_) => f64::INFINITY,
         }
     }
     /// Columns of the chain parameters and angle shifts, analytic.
-    fn chain_columns(&self, j: &mut DMatrix<f64>) {
-        let kc = self.coefficients().to_array();
+    fn chain_columns(&self, j: &mut DMatrix<f64>, tables: &Tables) {
         let as_ = self.angle_start();
+        let y_all = Self::chained_models(tables, &self.coefficients().to_array());
         let mut row = 0;
         self.rows(|c, comp, k, s| {
             let axis = self.cases[c].waveform.components[comp].axis;
@@ -555,7 +743,8 @@ impl HarmonicProblem<'_> {
                     j[(row + 1, col)] = v.im * s;
                 }
             };
-            let y = |m: usize| self.factor(c, axis, m) * self.model_harmonic(c, axis, m, &kc);
+            let ym = &y_all[c][comp];
+            let y = |m: usize| ym[m];
             if let Some(mi) = self.mode_axes.iter().position(|&a| a == axis) {
                 let mode = self.mode(mi);
                 let f = |m: usize| m as f64 * self.data[c].spindle_hz;
@@ -629,26 +818,25 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for HarmonicProblem<'_> {
         } else {
             self.n_runout()
         };
+        // (the residuals at the shifted runout: only the basis changes, the rest of x is kept)
+        let shifted = |p: usize, step: f64| {
+            let mut x = self.x.clone();
+            x[p] += step;
+            let (e, t) = self.runout_of(&x);
+            self.residual_vec_with(&self.tables_for(&self.basis_at(e, t)))
+        };
         for p in 0..runout_cols {
-            let mut plus = self.clone();
-            plus.x[p] += RUNOUT_STEP_UM;
-            plus.recompute();
-            let mut minus = self.clone();
-            minus.x[p] -= RUNOUT_STEP_UM;
-            minus.recompute();
-            for (r, (a, b)) in plus
-                .residual_vec()
-                .iter()
-                .zip(minus.residual_vec())
-                .enumerate()
-            {
+            let plus = shifted(p, RUNOUT_STEP_UM);
+            let minus = shifted(p, -RUNOUT_STEP_UM);
+            for (r, (a, b)) in plus.iter().zip(minus).enumerate() {
                 j[(r, p)] = (a - b) / (2.0 * RUNOUT_STEP_UM);
             }
         }
-        let design = self.coefficient_design();
+        let tables = self.tables();
+        let design = self.coefficient_design(&tables);
         j.columns_mut(self.coef_start(), self.coef_idx.len())
             .copy_from(&design);
-        self.chain_columns(&mut j);
+        self.chain_columns(&mut j, &tables);
         j.iter().all(|v| v.is_finite()).then_some(j)
     }
 }
@@ -821,26 +1009,31 @@ fn grid_costs(
     grid: &[(f64, f64)],
     set: &(impl Fn(&mut HarmonicProblem<'_>, &[usize], f64, f64) + Sync),
 ) -> Vec<f64> {
+    // the candidates change the modes only: the rest of the tables is computed once
+    let base = p.tables();
     if rayon::current_num_threads() <= 1 || grid.len() < 2 {
         return grid
             .iter()
             .map(|&(f, z)| {
                 set(p, ms, f, z);
-                p.profile_cost()
+                let t = p.with_modes(&base);
+                p.profile_cost_with(&t)
             })
             .collect();
     }
     let (c0, nk) = (p.coef_start(), p.coef_idx.len());
     let shared: &HarmonicProblem<'_> = p;
+    let base = &base;
     let evaluated: Vec<(f64, Option<Vec<f64>>)> = grid
         .par_iter()
         .map_init(
             || shared.clone(),
             |q, &(f, z)| {
                 set(q, ms, f, z);
-                match q.linear_coefficients() {
+                let tables = q.with_modes(base);
+                match q.linear_coefficients_with(&tables) {
                     Ok(()) => {
-                        let c = q.residual_vec().iter().map(|r| r * r).sum();
+                        let c = q.residual_vec_with(&tables).iter().map(|r| r * r).sum();
                         (c, Some((0..nk).map(|i| q.x[c0 + i]).collect()))
                     }
                     Err(_) => (f64::INFINITY, None),
