@@ -197,12 +197,10 @@ impl RevolutionModel {
             dnx: Vec::with_capacity(kk),
             dny: Vec::with_capacity(kk),
         };
+        let mut pts = Vec::with_capacity(k);
         for j in 0..self.disks {
-            let (dr, dn) = self.differences(j, e, tau);
             lanes.feed.extend_from_slice(&self.feed);
-            lanes.dr.extend_from_slice(&dr);
-            lanes.dnx.extend(dn.iter().map(|d| d[0]));
-            lanes.dny.extend(dn.iter().map(|d| d[1]));
+            self.differences_into(j, e, tau, &mut pts, &mut lanes);
         }
         let lanes = ArcGrad(lanes);
         let opts = Options {
@@ -231,8 +229,13 @@ impl RevolutionModel {
         // baseline still does): same splitter, same halves, same left + right sums, so the
         // results are bit-identical to it — without a dispatch per disk and an accumulator per
         // rayon split.
-        let acc = if self.disks >= 8 {
-            split_sum(0..self.disks, rayon::current_num_threads(), false, &run)
+        let threads = rayon::current_num_threads();
+        let acc = if self.disks >= 8 && threads == 1 {
+            // one thread: the same grouping without handing the work to the pool
+            let outside = rayon::current_thread_index().is_none();
+            split_sum_fixed(0..self.disks, 1, 1, false, outside, false, &run)
+        } else if self.disks >= 8 {
+            split_sum(0..self.disks, threads, false, &run)
         } else {
             run(0..self.disks)
         };
@@ -262,33 +265,35 @@ impl RevolutionModel {
         BasisSums { base, deriv }
     }
 
-    /// Per (tooth, m) of disk j: R_i − R_{i−m} and n_i − n_{i−m} for runout e₀ + zτ.
-    fn differences(&self, j: usize, e: [f64; 2], tau: [f64; 2]) -> (Vec<f64>, Vec<[f64; 2]>) {
+    /// Per (tooth, m) of disk j: R_i − R_{i−m} and n_i − n_{i−m} for runout e₀ + zτ, appended
+    /// to the lanes' `dr`, `dnx`, `dny` (index i·K + m − 1; `pts` is scratch space).
+    fn differences_into(
+        &self,
+        j: usize,
+        e: [f64; 2],
+        tau: [f64; 2],
+        pts: &mut Vec<([f64; 2], f64)>,
+        lanes: &mut ArcLanes,
+    ) {
         let k = self.k;
         let disk = self.table.disk(j);
         let z = disk.z;
         let ez = [e[0] + z * tau[0], e[1] + z * tau[1]];
         let r = disk.radius;
-        let pts: Vec<([f64; 2], f64)> = self
-            .table
-            .elements(j)
-            .iter()
-            .map(|sl| {
-                let p = [r * sl.cos_psi + ez[0], r * sl.sin_psi + ez[1]];
-                let ri = p[0].hypot(p[1]);
-                ([p[0] / ri, p[1] / ri], ri)
-            })
-            .collect();
-        let mut dr = vec![0.0; k * k];
-        let mut dn = vec![[0.0f64; 2]; k * k];
+        pts.clear();
+        pts.extend(self.table.elements(j).iter().map(|sl| {
+            let p = [r * sl.cos_psi + ez[0], r * sl.sin_psi + ez[1]];
+            let ri = p[0].hypot(p[1]);
+            ([p[0] / ri, p[1] / ri], ri)
+        }));
         for i in 0..k {
             for m in 1..=k {
                 let o = (i + k * m - m) % k;
-                dr[i * k + m - 1] = pts[i].1 - pts[o].1;
-                dn[i * k + m - 1] = [pts[i].0[0] - pts[o].0[0], pts[i].0[1] - pts[o].0[1]];
+                lanes.dr.push(pts[i].1 - pts[o].1);
+                lanes.dnx.push(pts[i].0[0] - pts[o].0[0]);
+                lanes.dny.push(pts[i].0[1] - pts[o].0[1]);
             }
         }
-        (dr, dn)
     }
 
     /// The loop before issue 18; `GENERAL = false` accumulates only the cylinder's rows 0–5
@@ -499,6 +504,70 @@ where
         |c| split_sum(disks.start..mid, splits, c.migrated(), run),
         |c| split_sum(mid..disks.end, splits, c.migrated(), run),
     );
+    a.add(&b);
+    a
+}
+
+/// [`split_sum`]'s grouping when no half is stolen: a half is "migrated" only when its join was
+/// injected into the pool from a thread outside it (`outside`, at the top; rayon then runs both
+/// halves with the injected flag), with `threads` the pool's thread count. On a pool of one
+/// thread nothing is ever stolen, so this is exactly [`split_sum`]'s (and rayon's
+/// `fold`/`reduce`'s) grouping there. The halves run in parallel ([`rayon::join`]) when
+/// `parallel`, else one after the other: the same sums in the same order either way.
+fn split_sum_fixed<F>(
+    disks: std::ops::Range<usize>,
+    threads: usize,
+    mut splits: usize,
+    migrated: bool,
+    outside: bool,
+    parallel: bool,
+    run: &F,
+) -> Acc
+where
+    F: Fn(std::ops::Range<usize>) -> Acc + Sync,
+{
+    let len = disks.len();
+    let split = len / 2 >= 1
+        && if migrated {
+            splits = threads.max(splits / 2);
+            true
+        } else if splits > 0 {
+            splits /= 2;
+            true
+        } else {
+            false
+        };
+    if !split {
+        return run(disks);
+    }
+    let mid = disks.start + len / 2;
+    let left = || {
+        split_sum_fixed(
+            disks.start..mid,
+            threads,
+            splits,
+            outside,
+            false,
+            parallel,
+            run,
+        )
+    };
+    let right = || {
+        split_sum_fixed(
+            mid..disks.end,
+            threads,
+            splits,
+            outside,
+            false,
+            parallel,
+            run,
+        )
+    };
+    let (mut a, b) = if parallel {
+        rayon::join(left, right)
+    } else {
+        (left(), right())
+    };
     a.add(&b);
     a
 }
