@@ -725,7 +725,7 @@ impl HarmonicProblem<'_> {
     }
     /// [`HarmonicProblem::profile_cost`] with the tables of the current parameters.
     fn profile_cost_with(&mut self, tables: &Tables) -> f64 {
-        match self.linear_coefficients_with(&tables) {
+        match self.linear_coefficients_with(tables) {
             Ok(()) => self.residual_vec_with(tables).iter().map(|r| r * r).sum(),
             Err(_) => f64::INFINITY,
         }

@@ -225,17 +225,18 @@ impl RevolutionModel {
             acc
         };
         // Disks in contiguous blocks, one kernel dispatch and one accumulator per block, split
-        // and summed exactly as rayon's `fold`/`reduce` over single disks did before (and the
-        // baseline still does): same splitter, same halves, same left + right sums, so the
-        // results are bit-identical to it — without a dispatch per disk and an accumulator per
-        // rayon split.
-        let threads = rayon::current_num_threads();
-        let acc = if self.disks >= 8 && threads == 1 {
-            // one thread: the same grouping without handing the work to the pool
+        // and summed as rayon's `fold`/`reduce` over single disks did before (and the baseline
+        // still does) on a pool of one thread: same splitter, same halves, same left + right
+        // sums, so the results are bit-identical to it there — without a dispatch per disk and
+        // an accumulator per rayon split. The grouping is that of one thread at any thread
+        // count (rayon's own depends on the thread count and on which halves were stolen, so
+        // its last digits varied from run to run on two threads): the results do not depend
+        // on the threads. The halves run in parallel only when the work is large enough to
+        // repay waking the pool's threads.
+        let acc = if self.disks >= 8 {
             let outside = rayon::current_thread_index().is_none();
-            split_sum_fixed(0..self.disks, 1, 1, false, outside, false, &run)
-        } else if self.disks >= 8 {
-            split_sum(0..self.disks, threads, false, &run)
+            let parallel = rayon::current_num_threads() > 1 && self.disks * n >= PARALLEL_WORK;
+            split_sum(0..self.disks, 1, false, outside, parallel, &run)
         } else {
             run(0..self.disks)
         };
@@ -476,47 +477,20 @@ impl RevolutionModel {
     }
 }
 
-/// `run` over `disks`, split in halves (at len/2) and the halves run in parallel
-/// ([`rayon::join_context`]) and summed left + right, with the decisions of rayon's adaptive
-/// splitter (`splits` starts at the pool's thread count and halves per split; a half run by
-/// another thread than the one that split resets it to the thread count): the grouping of
-/// `(0..disks).into_par_iter().fold(…).reduce(…)`, with whole blocks as leaves.
-fn split_sum<F>(disks: std::ops::Range<usize>, mut splits: usize, migrated: bool, run: &F) -> Acc
-where
-    F: Fn(std::ops::Range<usize>) -> Acc + Sync,
-{
-    let len = disks.len();
-    let split = len / 2 >= 1
-        && if migrated {
-            splits = rayon::current_num_threads().max(splits / 2);
-            true
-        } else if splits > 0 {
-            splits /= 2;
-            true
-        } else {
-            false
-        };
-    if !split {
-        return run(disks);
-    }
-    let mid = disks.start + len / 2;
-    let (mut a, b) = rayon::join_context(
-        |c| split_sum(disks.start..mid, splits, c.migrated(), run),
-        |c| split_sum(mid..disks.end, splits, c.migrated(), run),
-    );
-    a.add(&b);
-    a
-}
+/// Disk blocks × grid samples from which [`split_sum`] runs the halves in parallel (below, a
+/// compute takes tens of µs, the order of waking the pool's threads).
+const PARALLEL_WORK: usize = 16_384;
 
-/// [`split_sum`]'s grouping when no half is stolen: a half is "migrated" only when its join was
-/// injected into the pool from a thread outside it (`outside`, at the top; rayon then runs both
-/// halves with the injected flag), with `threads` the pool's thread count. On a pool of one
-/// thread nothing is ever stolen, so this is exactly [`split_sum`]'s (and rayon's
-/// `fold`/`reduce`'s) grouping there. The halves run in parallel ([`rayon::join`]) when
+/// `run` over `disks`, split in halves (at len/2) and summed left + right, with the decisions
+/// of rayon's adaptive splitter (`splits` starts at the pool's thread count and halves per
+/// split; a half that runs "migrated" resets it to the thread count) on a pool of ONE thread,
+/// where nothing is stolen: a half is migrated only when its join was injected into the pool
+/// from a thread outside it (`outside`, the top join; rayon then runs both halves with the
+/// injected flag). That is the grouping of `(0..disks).into_par_iter().fold(…).reduce(…)`
+/// there, with whole blocks as leaves. The halves run in parallel ([`rayon::join`]) when
 /// `parallel`, else one after the other: the same sums in the same order either way.
-fn split_sum_fixed<F>(
+fn split_sum<F>(
     disks: std::ops::Range<usize>,
-    threads: usize,
     mut splits: usize,
     migrated: bool,
     outside: bool,
@@ -529,7 +503,7 @@ where
     let len = disks.len();
     let split = len / 2 >= 1
         && if migrated {
-            splits = threads.max(splits / 2);
+            splits = 1.max(splits / 2);
             true
         } else if splits > 0 {
             splits /= 2;
@@ -541,28 +515,8 @@ where
         return run(disks);
     }
     let mid = disks.start + len / 2;
-    let left = || {
-        split_sum_fixed(
-            disks.start..mid,
-            threads,
-            splits,
-            outside,
-            false,
-            parallel,
-            run,
-        )
-    };
-    let right = || {
-        split_sum_fixed(
-            mid..disks.end,
-            threads,
-            splits,
-            outside,
-            false,
-            parallel,
-            run,
-        )
-    };
+    let left = || split_sum(disks.start..mid, splits, outside, false, parallel, run);
+    let right = || split_sum(mid..disks.end, splits, outside, false, parallel, run);
     let (mut a, b) = if parallel {
         rayon::join(left, right)
     } else {
