@@ -719,6 +719,34 @@ impl HarmonicProblem<'_> {
         }
         Ok(())
     }
+    /// The coefficients of a mode-scan candidate: [`HarmonicProblem::linear_coefficients_with`]
+    /// by the normal equations (XᵀX)β = Xᵀy (Cholesky) instead of the SVD, when
+    /// κ(XᵀX) ≤ ‖XᵀX‖_F‖(XᵀX)⁻¹‖_F < 1e20 proves κ(X) < 1e10, far inside the SVD's rank test
+    /// (1e-12); otherwise by the SVD, with its errors. The scan only compares costs: at a
+    /// least-squares optimum the cost is stationary in β, so the β error of the normal equations
+    /// (relative κ(X)²·ε ≈ 1e-10 at κ(X) ~ 1e3) moves the cost by its square — far below the
+    /// differences between grid points — and every fit that reports coefficients solves them
+    /// again by the SVD afterwards.
+    fn scan_coefficients(&mut self, tables: &Tables) -> Result<(), IdentifyError> {
+        if self.coef_idx.is_empty() {
+            return Ok(());
+        }
+        let x = self.coefficient_design(tables);
+        let a = x.tr_mul(&x);
+        let Some(chol) = a.clone().cholesky() else {
+            return self.linear_coefficients_with(tables);
+        };
+        let bound = a.norm() * chol.inverse().norm();
+        if bound.is_nan() || bound >= 1e20 {
+            return self.linear_coefficients_with(tables);
+        }
+        let beta = chol.solve(&x.tr_mul(&tables.y));
+        let c0 = self.coef_start();
+        for c in 0..self.coef_idx.len() {
+            self.x[c0 + c] = beta[c];
+        }
+        Ok(())
+    }
     fn profile_cost(&mut self) -> f64 {
         let tables = self.tables();
         self.profile_cost_with(&tables)
@@ -1017,7 +1045,10 @@ fn grid_costs(
             .map(|&(f, z)| {
                 set(p, ms, f, z);
                 let t = p.with_modes(&base);
-                p.profile_cost_with(&t)
+                match p.scan_coefficients(&t) {
+                    Ok(()) => p.residual_vec_with(&t).iter().map(|r| r * r).sum(),
+                    Err(_) => f64::INFINITY,
+                }
             })
             .collect();
     }
@@ -1031,7 +1062,7 @@ fn grid_costs(
             |q, &(f, z)| {
                 set(q, ms, f, z);
                 let tables = q.with_modes(base);
-                match q.linear_coefficients_with(&tables) {
+                match q.scan_coefficients(&tables) {
                     Ok(()) => {
                         let c = q.residual_vec_with(&tables).iter().map(|r| r * r).sum();
                         (c, Some((0..nk).map(|i| q.x[c0 + i]).collect()))
