@@ -211,19 +211,19 @@ fn first_pass<R: BufRead + Send>(
         }
         scope.spawn(move || {
             // ends at the end of the data, at an error, or when the consumer has stopped
-            while let Ok(mut chunk) = free_rx.recv() {
-                match reader.read_chunk(&mut chunk, ROWS) {
-                    Ok(0) => break,
-                    Ok(n) => {
-                        if full_tx.send(Ok((chunk, n, reader.bytes_read()))).is_err() {
-                            break;
-                        }
-                    }
-                    Err(e) => {
-                        full_tx.send(Err(e)).ok();
-                        break;
-                    }
-                }
+            let Ok(mut chunk) = free_rx.recv() else {
+                return;
+            };
+            let workers = std::thread::available_parallelism().map_or(1, |n| n.get().min(4));
+            let read = reader.for_each_chunk(&mut chunk, ROWS, workers, |chunk, n, bytes| {
+                let Ok(next) = free_rx.recv() else {
+                    return false;
+                };
+                let full = std::mem::replace(chunk, next);
+                full_tx.send(Ok((full, n, bytes))).is_ok()
+            });
+            if let Err(e) = read {
+                full_tx.send(Err(e)).ok();
             }
         });
         let mut out = RecordingChunk {
