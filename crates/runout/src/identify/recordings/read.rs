@@ -188,10 +188,11 @@ pub(super) fn analyse(
 
 /// Pass 1: the source in chunks, mapped to the workpiece frame in N, spilled and fed on.
 ///
-/// Pipelined (issue 18): a second thread parses the next chunks (up to [`AHEAD`] ahead, their
-/// buffers recycled) while this one maps, spills and averages the current one; chunks arrive
-/// in order and the first read error is returned after the chunks before it, as in a single
-/// loop.
+/// Pipelined (issue 18): a second thread reads the next chunks (up to [`AHEAD`] ahead, their
+/// buffers recycled) while this one maps, spills and averages the current one; a text
+/// recording's rows are parsed on one worker per core (up to 4,
+/// `RecordingReader::for_each_chunk`). Chunks arrive in order and the first read error is
+/// returned after the chunks before it, as in a single loop.
 fn first_pass<R: BufRead + Send>(
     reader: &mut RecordingReader<R>,
     ch: &Channels,
