@@ -2,7 +2,8 @@
 //! ≥ 100 MB/s), against two baselines in the same run: the `csv` crate's `ByteRecord` reader with
 //! `str::parse::<f64>` per cell (what a straightforward implementation would do), and the reader's
 //! own line path before issue 18 (each line copied out of a `BufReader` by `read_until`, split,
-//! cells parsed by the same float parser; kept here as `old_line_copy_path`).
+//! cells parsed by the same float parser; kept here as `old_line_copy_path`). `runout_reader_2_threads`
+//! is the same reader with the data rows parsed on two threads (`for_each_chunk`, issue 18).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use runout_io::recording::{ReadOptions, RecordingChunk, RecordingReader};
@@ -32,6 +33,19 @@ fn read_all_ours(bytes: &[u8]) -> f64 {
     while r.read_chunk(&mut c, 65_536).unwrap() > 0 {
         sum += c.values[0].iter().sum::<f64>();
     }
+    sum
+}
+
+/// The same reader with its data rows parsed on two threads (`for_each_chunk`, issue 18).
+fn read_all_ours_2_threads(bytes: &[u8]) -> f64 {
+    let mut r = RecordingReader::from_bytes("bench.csv", bytes, &ReadOptions::new()).unwrap();
+    let mut c = RecordingChunk::default();
+    let mut sum = 0.0;
+    r.for_each_chunk(&mut c, 65_536, 2, |c, _, _| {
+        sum += c.values[0].iter().sum::<f64>();
+        true
+    })
+    .unwrap();
     sum
 }
 
@@ -166,11 +180,15 @@ fn bench(c: &mut Criterion) {
     let bytes = generate(400_000);
     assert_eq!(read_all_ours(&bytes), read_all_csv_crate(&bytes));
     assert_eq!(read_all_ours(&bytes), read_all_old_line_copy_path(&bytes));
+    assert_eq!(read_all_ours(&bytes), read_all_ours_2_threads(&bytes));
     let mut g = c.benchmark_group("parse_csv_5col");
     g.throughput(Throughput::Bytes(bytes.len() as u64));
     g.sample_size(10);
     g.bench_function("runout_reader", |b| {
         b.iter(|| black_box(read_all_ours(black_box(&bytes))))
+    });
+    g.bench_function("runout_reader_2_threads", |b| {
+        b.iter(|| black_box(read_all_ours_2_threads(black_box(&bytes))))
     });
     g.bench_function("old_line_copy_path", |b| {
         b.iter(|| black_box(read_all_old_line_copy_path(black_box(&bytes))))

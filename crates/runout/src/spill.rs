@@ -57,15 +57,19 @@ impl Spill {
             .as_mut()
             .expect("spill written before it is read");
         let n = chunk.len();
-        let mut bytes = Vec::with_capacity(8 + 8 * n * self.channels);
-        bytes.extend_from_slice(&(n as u64).to_le_bytes());
+        w.write_all(&(n as u64).to_le_bytes())?;
+        // straight into the writer's buffer, a few values at a time (no block-sized copy)
+        let mut bytes = [0u8; 8 * 64];
         for c in chunk.values.iter().take(self.channels) {
-            for v in c {
-                bytes.extend_from_slice(&v.to_le_bytes());
+            for part in c.chunks(64) {
+                for (b, v) in bytes.chunks_exact_mut(8).zip(part) {
+                    b.copy_from_slice(&v.to_le_bytes());
+                }
+                w.write_all(&bytes[..8 * part.len()])?;
             }
         }
         self.rows += n as u64;
-        w.write_all(&bytes)
+        Ok(())
     }
 
     /// Finish writing and read the blocks back from the start.

@@ -72,6 +72,9 @@ const ROWS: &[Row] = &[
     // ---- recordings (identify) ----
     Row { name: "empty recording", files: &[("rec.csv", Text("")), CUT], args: IDENTIFY,
           expect: &["rec.csv", "empty"] },
+    Row { name: "empty Parquet recording", files: &[("rec.parquet", Text("")), CUT],
+          args: "identify {d}/rec.parquet --config {d}/cut.toml --json {d}/id.json",
+          expect: &["rec.parquet", "empty", "Parquet file"] },
     Row { name: "binary recording", files: &[("rec.csv", Bytes(b"PK\x03\x04\x00\x00\x08\x00\xff\xfe")), CUT],
           args: IDENTIFY, expect: &["rec.csv:1", "binary"] },
     Row { name: "row with a missing field", files: &[("rec.csv", Text("time_s,Fx,Fy,Fz\n0,1,2,3\n0.001,1.5,2\n")), CUT],

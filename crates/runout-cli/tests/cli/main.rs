@@ -27,6 +27,7 @@ mod identify_peaks;
 mod identify_recording;
 mod install;
 mod issue20;
+mod progress_tty;
 mod readme_commands;
 mod shank;
 mod simulate;

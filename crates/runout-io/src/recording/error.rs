@@ -13,8 +13,12 @@ pub enum RecordingError {
         /// The I/O error.
         error: std::io::Error,
     },
-    /// The file has no content at all (or only blank lines).
-    #[error("{file}: the file is empty (expected a header row, then data rows)")]
+    /// The file has no content at all (or only blank lines). The format cannot be told from no
+    /// bytes, so the message names what any of them would start with.
+    #[error(
+        "{file}: the file is empty: expected a recording (a text export with a header row, then \
+         data rows, or a MATLAB, HDF5, TDMS or Parquet file)"
+    )]
     Empty {
         /// The file.
         file: String,

@@ -43,8 +43,57 @@ pub(crate) fn trim_field(mut b: &[u8]) -> &[u8] {
 /// come from positions, not per-digit counters (issue 18: ≈ 1.6× the per-digit state machine
 /// it replaced). With at most 19 digits the mantissa is exact in a `u64`; Clinger's fast path
 /// then applies as described in the module docs, anything else goes to [`slow_parse`].
-#[inline]
+///
+/// The common cell (digits, an optional fraction, no exponent, at most 19 digits, a mantissa
+/// below 2⁵³) is parsed inline; anything else goes to [`parse_number_full`], which gives the
+/// same result for the common cells (issue 18: the fast path inlined into the row loop).
+#[inline(always)]
 pub(crate) fn parse_number(cell: &[u8], decimal_comma: bool) -> Option<f64> {
+    let b = trim_field(cell);
+    let n = b.len();
+    let (neg, mut i) = match b.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    let mut mant: u64 = 0;
+    let int_start = i;
+    while i < n {
+        let d = b[i].wrapping_sub(b'0');
+        if d >= 10 {
+            break;
+        }
+        mant = mant.wrapping_mul(10).wrapping_add(u64::from(d));
+        i += 1;
+    }
+    let int_digits = i - int_start;
+    let mut frac_digits = 0;
+    if i < n && (b[i] == b'.' || (decimal_comma && b[i] == b',')) {
+        i += 1;
+        let frac_start = i;
+        while i < n {
+            let d = b[i].wrapping_sub(b'0');
+            if d >= 10 {
+                break;
+            }
+            mant = mant.wrapping_mul(10).wrapping_add(u64::from(d));
+            i += 1;
+        }
+        frac_digits = i - frac_start;
+    }
+    let digits = int_digits + frac_digits;
+    if i < n || digits == 0 || digits > 19 || mant >= (1u64 << 53) || frac_digits > 22 {
+        return parse_number_full(b, decimal_comma);
+    }
+    let v = mant as f64 / POW10[frac_digits];
+    Some(if neg { -v } else { v })
+}
+
+/// [`parse_number`] for any cell (already trimmed; trimming again changes nothing): exponents,
+/// long mantissas and rejections.
+#[cold]
+#[inline(never)]
+fn parse_number_full(cell: &[u8], decimal_comma: bool) -> Option<f64> {
     let b = trim_field(cell);
     let n = b.len();
     let (neg, mut i) = match b.first() {

@@ -188,10 +188,11 @@ pub(super) fn analyse(
 
 /// Pass 1: the source in chunks, mapped to the workpiece frame in N, spilled and fed on.
 ///
-/// Pipelined (issue 18): a second thread parses the next chunks (up to [`AHEAD`] ahead, their
-/// buffers recycled) while this one maps, spills and averages the current one; chunks arrive
-/// in order and the first read error is returned after the chunks before it, as in a single
-/// loop.
+/// Pipelined (issue 18): a second thread reads the next chunks (up to [`AHEAD`] ahead, their
+/// buffers recycled) while this one maps, spills and averages the current one; a text
+/// recording's rows are parsed on one worker per core (up to 4,
+/// `RecordingReader::for_each_chunk`). Chunks arrive in order and the first read error is
+/// returned after the chunks before it, as in a single loop.
 fn first_pass<R: BufRead + Send>(
     reader: &mut RecordingReader<R>,
     ch: &Channels,
@@ -211,19 +212,19 @@ fn first_pass<R: BufRead + Send>(
         }
         scope.spawn(move || {
             // ends at the end of the data, at an error, or when the consumer has stopped
-            while let Ok(mut chunk) = free_rx.recv() {
-                match reader.read_chunk(&mut chunk, ROWS) {
-                    Ok(0) => break,
-                    Ok(n) => {
-                        if full_tx.send(Ok((chunk, n, reader.bytes_read()))).is_err() {
-                            break;
-                        }
-                    }
-                    Err(e) => {
-                        full_tx.send(Err(e)).ok();
-                        break;
-                    }
-                }
+            let Ok(mut chunk) = free_rx.recv() else {
+                return;
+            };
+            let workers = std::thread::available_parallelism().map_or(1, |n| n.get().min(4));
+            let read = reader.for_each_chunk(&mut chunk, ROWS, workers, |chunk, n, bytes| {
+                let Ok(next) = free_rx.recv() else {
+                    return false;
+                };
+                let full = std::mem::replace(chunk, next);
+                full_tx.send(Ok((full, n, bytes))).is_ok()
+            });
+            if let Err(e) = read {
+                full_tx.send(Err(e)).ok();
             }
         });
         let mut out = RecordingChunk {
@@ -302,23 +303,48 @@ fn as_signal(c: &RecordingChunk, has_z: bool) -> signal::SignalChunk<'_> {
     }
 }
 
-/// Passes 2 and 3: the spill read back.
+/// Passes 2 and 3: the spill read back, on a second thread (issue 18: reading and decoding
+/// the next blocks overlaps the pipeline's work on the current one; blocks arrive in order,
+/// a read error after the blocks before it).
 fn replay(
     spill: &mut Spill,
     has_z: bool,
     progress: &mut dyn Progress,
     sink: &mut signal::ChunkSink<'_>,
 ) -> Result<()> {
+    use std::sync::mpsc;
     let mut r = spill
         .reader()
         .with_context(|| format!("reading temporary file {}", spill.path().display()))?;
-    let mut chunk = RecordingChunk::default();
-    loop {
-        let n = r.read_chunk(&mut chunk)?;
-        if n == 0 {
-            return Ok(());
+    std::thread::scope(|scope| {
+        let (full_tx, full_rx) = mpsc::sync_channel::<std::io::Result<RecordingChunk>>(AHEAD);
+        let (free_tx, free_rx) = mpsc::channel::<RecordingChunk>();
+        for _ in 0..AHEAD + 1 {
+            free_tx.send(RecordingChunk::default()).ok();
         }
-        sink(as_signal(&chunk, has_z))?;
-        progress.advance((n * chunk.values.len() * 8) as u64);
-    }
+        scope.spawn(move || {
+            // ends at the end of the spill, at an error, or when the consumer has stopped
+            while let Ok(mut chunk) = free_rx.recv() {
+                match r.read_chunk(&mut chunk) {
+                    Ok(0) => break,
+                    Ok(_) => {
+                        if full_tx.send(Ok(chunk)).is_err() {
+                            break;
+                        }
+                    }
+                    Err(e) => {
+                        full_tx.send(Err(e)).ok();
+                        break;
+                    }
+                }
+            }
+        });
+        for read in full_rx {
+            let chunk = read?;
+            sink(as_signal(&chunk, has_z))?;
+            progress.advance((chunk.values[0].len() * chunk.values.len() * 8) as u64);
+            free_tx.send(chunk).ok();
+        }
+        Ok(())
+    })
 }

@@ -1,0 +1,379 @@
+//! Data rows parsed on several threads (issue 18): a splitter thread cuts the input after the
+//! read-ahead into jobs of whole lines (≈ [`JOB_BYTES`]), parse workers turn them into columns
+//! (round robin, so job `k` is worker `k mod W`'s), and the calling thread takes the results
+//! in file order: it numbers the samples, checks the time column and cuts the rows into chunks
+//! of the requested size — the same chunks, values, line numbers and first error as
+//! [`RecordingReader::read_chunk`] called in a loop.
+//!
+//! Memory is bounded by the jobs in flight: per worker one job queued, one being parsed and one
+//! result queued (≈ 3 × 1 MiB of text and its columns), whatever the file's length.
+
+use super::{
+    checked_time, long_line, trim_field, RecordingChunk, RecordingError, RecordingReader, Result,
+    RowParser, Slot, MAX_LINE_BYTES,
+};
+use std::io::{BufRead, Read};
+use std::sync::mpsc;
+
+/// Bytes of input per job (cut at the next line end).
+const JOB_BYTES: usize = 1 << 20;
+
+/// Work for a parse worker.
+enum Job {
+    /// Whole lines of the data section; the last one lacks its line end only at the end of the
+    /// input (or when it is too long, which the worker reports).
+    Lines(Vec<u8>),
+    /// The input could not be read after the lines of the jobs before.
+    Io(std::io::Error),
+}
+
+/// What a worker made of a job.
+#[derive(Default)]
+struct Parsed {
+    /// Rows parsed (before an error, if any).
+    rows: usize,
+    /// Their time cells, scaled to s (empty without a time column).
+    times: Vec<f64>,
+    /// Their values per channel.
+    values: Vec<Vec<f64>>,
+    /// 0-based lines of the job that held no row (blank), ascending.
+    blank: Vec<u64>,
+    /// Lines of the job.
+    lines: u64,
+    /// Bytes of the job.
+    bytes: u64,
+    /// The error at the job's last line (numbered from 1 at the job's first line).
+    error: Option<RecordingError>,
+}
+
+impl Parsed {
+    fn reset(&mut self, channels: usize) {
+        self.rows = 0;
+        self.times.clear();
+        self.values.resize_with(channels, Vec::new);
+        self.values.iter_mut().for_each(Vec::clear);
+        self.blank.clear();
+        self.lines = 0;
+        self.bytes = 0;
+        self.error = None;
+    }
+
+    /// The 0-based line in the job of row `row`.
+    fn line_of(&self, row: usize) -> u64 {
+        let mut line = row as u64;
+        for &b in &self.blank {
+            if b <= line {
+                line += 1;
+            } else {
+                break;
+            }
+        }
+        line
+    }
+}
+
+/// Parse the lines of a job as `Block::next_line` + `RecordingReader::parse_row` would (line
+/// length limit, `\r\n` endings, blank lines skipped), the time cells unchecked.
+fn parse_job(p: &RowParser<'_>, has_time: bool, bytes: &[u8], out: &mut Parsed) {
+    out.bytes = bytes.len() as u64;
+    let mut pos = 0;
+    let mut line = 0u64;
+    while pos < bytes.len() {
+        let rest = &bytes[pos..];
+        let (mut len, consumed) = match memchr::memchr(b'\n', rest) {
+            Some(k) => (k, k + 1),
+            None => (rest.len(), rest.len()),
+        };
+        line += 1;
+        if len as u64 >= MAX_LINE_BYTES {
+            out.error = Some(long_line(&p.info.file, line));
+            break;
+        }
+        pos += consumed;
+        if len > 0 && rest[len - 1] == b'\r' {
+            len -= 1;
+        }
+        let row = &rest[..len];
+        if trim_field(row).is_empty() {
+            out.blank.push(line - 1);
+            continue;
+        }
+        let mut time = None;
+        if let Err(e) = p.parse(line, row, &mut out.values, &mut time) {
+            for v in &mut out.values {
+                v.truncate(out.rows);
+            }
+            out.error = Some(e);
+            break;
+        }
+        if has_time {
+            out.times.push(time.unwrap_or(f64::NAN));
+        }
+        out.rows += 1;
+    }
+    out.lines = line;
+}
+
+/// Cut the input into jobs of whole lines, starting with `carry` (bytes read ahead, not
+/// parsed yet); job `k` goes to `jobs[k mod W]`. Ends at the end of the input, at a read error
+/// (sent in order, after the whole lines before it), or when a worker has stopped.
+fn split<R: Read>(
+    src: &mut R,
+    mut carry: Vec<u8>,
+    mut eof: bool,
+    jobs: Vec<mpsc::SyncSender<Job>>,
+    free: mpsc::Receiver<Vec<u8>>,
+) {
+    let w = jobs.len();
+    let mut k = 0;
+    let mut send = |job: Job| {
+        let sent = jobs[k % w].send(job).is_ok();
+        k += 1;
+        sent
+    };
+    loop {
+        if eof && carry.is_empty() {
+            return;
+        }
+        let mut buf = free.try_recv().unwrap_or_default();
+        buf.clear();
+        buf.append(&mut carry);
+        let mut searched = 0;
+        let mut failed = None;
+        let mut last = false;
+        let cut = loop {
+            if eof {
+                break buf.len();
+            }
+            if buf.len() >= JOB_BYTES {
+                if let Some(p) = memchr::memrchr(b'\n', &buf[searched..]) {
+                    break searched + p + 1;
+                }
+                searched = buf.len();
+                if buf.len() as u64 > MAX_LINE_BYTES {
+                    // no line end at all: the worker reports the line as too long
+                    last = true;
+                    break buf.len();
+                }
+            }
+            let len = buf.len();
+            buf.resize(len.max(JOB_BYTES - READ_BYTES) + READ_BYTES, 0);
+            let n = loop {
+                match src.read(&mut buf[len..]) {
+                    Ok(n) => break Some(n),
+                    Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                    Err(e) => {
+                        failed = Some(e);
+                        break None;
+                    }
+                }
+            };
+            buf.truncate(len + n.unwrap_or(0));
+            match n {
+                Some(0) => eof = true,
+                Some(_) => {}
+                None => break memchr::memrchr(b'\n', &buf).map_or(0, |p| p + 1),
+            }
+        };
+        carry.extend_from_slice(&buf[cut..]);
+        buf.truncate(cut);
+        if !buf.is_empty() && !send(Job::Lines(buf)) {
+            return;
+        }
+        if let Some(e) = failed {
+            send(Job::Io(e));
+            return;
+        }
+        if last {
+            return;
+        }
+    }
+}
+
+/// Bytes asked of the input per read.
+const READ_BYTES: usize = 1 << 16;
+
+impl<R: BufRead + Send> RecordingReader<R> {
+    /// Read all remaining rows in chunks of `max_rows` (the last one shorter), calling
+    /// `each(chunk, rows, bytes_read)` for each; `each` may swap the chunk for another
+    /// (recycled) one, and stops the reading by returning `false`. The chunks, their values,
+    /// the line numbers and the first error are those of [`RecordingReader::read_chunk`] in a
+    /// loop; a text recording's data rows are parsed on `workers` threads (binary formats,
+    /// table mode and `workers < 2` read serially). After it the reader is finished.
+    pub fn for_each_chunk(
+        &mut self,
+        chunk: &mut RecordingChunk,
+        max_rows: usize,
+        workers: usize,
+        mut each: impl FnMut(&mut RecordingChunk, usize, u64) -> bool,
+    ) -> Result<()> {
+        let max_rows = max_rows.max(1);
+        // serially: the lines read ahead at open (and what cannot be parsed in parallel)
+        loop {
+            let parallel = self.binary.is_none()
+                && self.row_lines.is_none()
+                && workers > 1
+                && self.lines.pending.is_empty()
+                && !self.finished;
+            if parallel {
+                break;
+            }
+            let n = self.read_chunk(chunk, max_rows)?;
+            if n == 0 || !each(chunk, n, self.bytes_read()) {
+                return Ok(());
+            }
+        }
+        let block = std::mem::take(&mut self.lines.block);
+        let carry = block.data[block.pos..block.end].to_vec();
+        let eof = block.eof;
+        drop(block);
+        let slots = self.slots.clone();
+        let info = self.info.clone();
+        let has_time = slots.contains(&Slot::Time);
+        let parser = RowParser {
+            slots: &slots,
+            delim: info.delimiter as u8,
+            dc: info.decimal_comma,
+            time_scale: self.time_scale,
+            info: &info,
+        };
+        let channels = info.channels.len();
+        let time_column = self.time_column;
+        let src = &mut self.lines.src;
+        let mut line_no = self.lines.line_no;
+        let mut bytes = self.lines.bytes;
+        let mut sample = self.sample;
+        let mut previous = self.previous_time;
+        let reset = |chunk: &mut RecordingChunk, sample: u64| {
+            chunk.first_sample = sample;
+            chunk.time_s.clear();
+            chunk.values.resize_with(channels, Vec::new);
+            chunk.values.iter_mut().for_each(Vec::clear);
+        };
+        let ended = std::thread::scope(|scope| -> Result<bool> {
+            let mut job_tx = Vec::new();
+            let mut res_rx = Vec::new();
+            let mut free_res = Vec::new();
+            let (free_buf_tx, free_buf_rx) = mpsc::channel::<Vec<u8>>();
+            for _ in 0..workers {
+                let (jt, jr) = mpsc::sync_channel::<Job>(1);
+                let (rt, rr) = mpsc::sync_channel::<Parsed>(1);
+                let (ft, fr) = mpsc::channel::<Parsed>();
+                let free_buf_tx = free_buf_tx.clone();
+                let info = &info;
+                scope.spawn(move || {
+                    for job in jr {
+                        let mut out = fr.try_recv().unwrap_or_default();
+                        out.reset(channels);
+                        match job {
+                            Job::Lines(b) => {
+                                parse_job(&parser, has_time, &b, &mut out);
+                                free_buf_tx.send(b).ok();
+                            }
+                            Job::Io(error) => {
+                                out.error = Some(RecordingError::Io {
+                                    file: info.file.clone(),
+                                    error,
+                                })
+                            }
+                        }
+                        if rt.send(out).is_err() {
+                            break;
+                        }
+                    }
+                });
+                job_tx.push(jt);
+                res_rx.push(rr);
+                free_res.push(ft);
+            }
+            drop(free_buf_tx);
+            scope.spawn(move || split(src, carry, eof, job_tx, free_buf_rx));
+            reset(chunk, sample);
+            let mut result = Ok(true);
+            'jobs: for k in 0.. {
+                let w = k % workers;
+                let Ok(p) = res_rx[w].recv() else { break };
+                let mut r = 0;
+                while r < p.rows {
+                    if chunk.len() == max_rows {
+                        if !each(chunk, max_rows, bytes) {
+                            result = Ok(false);
+                            break 'jobs;
+                        }
+                        reset(chunk, sample);
+                    }
+                    let take = (max_rows - chunk.len()).min(p.rows - r);
+                    let mut good = take;
+                    for i in r..r + take {
+                        let time = has_time.then(|| p.times[i]);
+                        let line = || line_no + 1 + p.line_of(i);
+                        match checked_time(&info, time_column, sample, &mut previous, time, line) {
+                            Ok(t) => {
+                                chunk.time_s.push(t);
+                                sample += 1;
+                            }
+                            Err(e) => {
+                                good = i - r;
+                                result = Err(e);
+                                break;
+                            }
+                        }
+                    }
+                    for (c, v) in chunk.values.iter_mut().zip(&p.values) {
+                        c.extend_from_slice(&v[r..r + good]);
+                    }
+                    if result.is_err() {
+                        break 'jobs;
+                    }
+                    r += take;
+                }
+                if let Some(mut e) = p.error {
+                    shift_line(&mut e, line_no);
+                    result = Err(e);
+                    break;
+                }
+                line_no += p.lines;
+                bytes += p.bytes;
+                free_res[w].send(p).ok();
+            }
+            drop(res_rx);
+            if matches!(result, Ok(true)) && !chunk.time_s.is_empty() {
+                let n = chunk.len();
+                if !each(chunk, n, bytes) {
+                    result = Ok(false);
+                }
+            }
+            result
+        });
+        self.lines.line_no = line_no;
+        self.lines.bytes = bytes;
+        self.sample = sample;
+        self.previous_time = previous;
+        match ended {
+            Ok(true) => {
+                self.finish();
+                Ok(())
+            }
+            Ok(false) => {
+                self.finished = true;
+                Ok(())
+            }
+            Err(e) => {
+                self.finished = true;
+                Err(e)
+            }
+        }
+    }
+}
+
+/// Number an error's line from the job's first line (`before` lines precede the job).
+fn shift_line(e: &mut RecordingError, before: u64) {
+    match e {
+        RecordingError::Binary { line, .. }
+        | RecordingError::FieldCount { line, .. }
+        | RecordingError::NotNumeric { line, .. }
+        | RecordingError::TimeNotMonotonic { line, .. }
+        | RecordingError::RateInconsistent { line, .. } => *line += before,
+        _ => {}
+    }
+}
