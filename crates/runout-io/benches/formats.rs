@@ -3,7 +3,7 @@
 //! compressed), TDMS, HDF5 and Parquet by `tests/fixtures/make_fixtures.py --bench` (needs
 //! python3 with scipy, h5py, nptdms, pyarrow; formats whose file is missing are skipped with a
 //! message). Each benchmark opens the file through `open_recording` and reads every chunk;
-//! criterion's throughput is bytes of the file (MB/s); samples/s = 1e6 × 4 / time.
+//! criterion's throughput is bytes of the file (MB/s); rows/s = 1e6 / time (4 samples a row).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use runout_io::recording::{open_recording, ReadOptions, RecordingChunk};
