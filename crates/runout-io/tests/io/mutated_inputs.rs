@@ -477,3 +477,116 @@ fn mutations_do_what_they_say() {
         b"ab\nY"
     );
 }
+
+/// Two long recordings (past the 1 000 rows read ahead at open, so that the data rows go
+/// through the parallel parser): comma-separated with a time column, and semicolon-separated
+/// with decimal commas; values in the formats exports use (signs, exponents, long mantissas).
+fn long_recordings() -> &'static [&'static [u8]] {
+    static LONG: std::sync::OnceLock<Vec<&'static [u8]>> = std::sync::OnceLock::new();
+    LONG.get_or_init(|| {
+        let cell = |i: usize, k: usize| -> String {
+            let x = ((i * 7919 + k * 104_729) % 20_011) as f64 / 97.0 - 100.0;
+            match (i + k) % 4 {
+                0 => format!("{x}"),
+                1 => format!("{x:.3}"),
+                2 => format!("{:e}", x * 1e-3),
+                _ => format!("{}", x.round() as i64),
+            }
+        };
+        let mut comma = String::from("time_s,Fx,Fy,Fz\n");
+        let mut semi = String::from("Zeit [s];Fx [N];Fy [N]\n");
+        for i in 0..2_500 {
+            let t = i as f64 * 1e-4;
+            comma += &format!("{t},{},{},{}\n", cell(i, 0), cell(i, 1), cell(i, 2));
+            let row = format!("{t};{};{}\n", cell(i, 3), cell(i, 4));
+            semi += &row.replace('.', ",");
+        }
+        vec![
+            Box::leak(comma.into_bytes().into_boxed_slice()) as &[u8],
+            Box::leak(semi.into_bytes().into_boxed_slice()) as &[u8],
+        ]
+    })
+}
+
+/// Chunks (as bits), the error message, bytes read and warnings of a reader's data rows.
+type Reading = (
+    Vec<(u64, Vec<u64>, Vec<Vec<u64>>)>,
+    Option<String>,
+    u64,
+    Vec<String>,
+);
+
+fn bits(c: &runout_io::recording::RecordingChunk) -> (u64, Vec<u64>, Vec<Vec<u64>>) {
+    let b = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+    (
+        c.first_sample,
+        b(&c.time_s),
+        c.values.iter().map(|v| b(v)).collect(),
+    )
+}
+
+/// `bytes` read with `read_chunk` in a loop (`workers` = 0) or parsed on `workers` threads in
+/// jobs of about `job_bytes` bytes; `None` when the header is refused (the same either way).
+fn reading(bytes: &[u8], rows: usize, workers: usize, job_bytes: usize) -> Option<Reading> {
+    use runout_io::recording::{RecordingChunk, RecordingReader};
+    let opts = ReadOptions::new().sample_rate_hz(10_000.0);
+    let mut r = RecordingReader::from_reader(std::io::Cursor::new(bytes), "rec.csv", &opts).ok()?;
+    let mut c = RecordingChunk::default();
+    let mut out = Vec::new();
+    let error = if workers == 0 {
+        loop {
+            match r.read_chunk(&mut c, rows) {
+                Ok(0) => break None,
+                Ok(_) => out.push(bits(&c)),
+                Err(e) => break Some(e.to_string()),
+            }
+        }
+    } else {
+        r.for_each_chunk_in_jobs_of(job_bytes, &mut c, rows, workers, |c, _, _| {
+            out.push(bits(c));
+            true
+        })
+        .err()
+        .map(|e| e.to_string())
+    };
+    Some((out, error, r.bytes_read(), r.warnings().to_vec()))
+}
+
+proptest! {
+    #![proptest_config(config(256))]
+
+    /// The parallel parser of `identify`'s pass 1 on mutated long recordings, cut into small
+    /// jobs so that many job seams fall anywhere in the data: the same chunks (bit for bit),
+    /// the same first error (message, line, column), the same bytes read and warnings as
+    /// `read_chunk` in a loop.
+    #[test]
+    fn recordings_parse_the_same_on_several_threads(
+        bytes in mutated(long_recordings()),
+        rows in prop_oneof![Just(1usize), 1..5_000usize],
+        workers in 2..4usize,
+        job_bytes in prop_oneof![1..64usize, 64..20_000usize],
+    ) {
+        // bytes read after an error: `read_chunk` counts the failing line, the parallel parser
+        // the jobs before it (progress only: the job stops at the error either way)
+        let ignore_bytes_after_error = |r: Option<Reading>| {
+            r.map(|(c, e, b, w)| { let b = if e.is_some() { 0 } else { b }; (c, e, b, w) })
+        };
+        let serial = ignore_bytes_after_error(reading(&bytes, rows, 0, 0));
+        let parallel = ignore_bytes_after_error(reading(&bytes, rows, workers, job_bytes));
+        prop_assert!(serial == parallel, "rows {rows}, {workers} workers, jobs of {job_bytes} B: {:?} / {:?}",
+            serial.as_ref().map(|s| (s.0.len(), &s.1, s.2)), parallel.as_ref().map(|s| (s.0.len(), &s.1, s.2)));
+    }
+}
+
+/// The long recordings themselves read without error past the read-ahead (so the property
+/// above is not vacuous), the same on several threads in jobs of a few rows.
+#[test]
+fn long_recordings_read_whole_on_several_threads() {
+    for bytes in long_recordings() {
+        let serial = reading(bytes, 700, 0, 0).expect("header accepted");
+        assert_eq!(serial.1, None, "no error");
+        let rows: usize = serial.0.iter().map(|c| c.1.len()).sum();
+        assert_eq!(rows, 2_500);
+        assert_eq!(Some(&serial), reading(bytes, 700, 3, 100).as_ref());
+    }
+}

@@ -119,11 +119,12 @@ fn parse_job(p: &RowParser<'_>, has_time: bool, bytes: &[u8], out: &mut Parsed) 
 /// (sent in order, after the whole lines before it), or when a worker has stopped.
 fn split<R: Read>(
     src: &mut R,
-    mut carry: Vec<u8>,
-    mut eof: bool,
+    (mut carry, mut eof): (Vec<u8>, bool),
+    job_bytes: usize,
     jobs: Vec<mpsc::SyncSender<Job>>,
     free: mpsc::Receiver<Vec<u8>>,
 ) {
+    let read_bytes = READ_BYTES.min(job_bytes);
     let w = jobs.len();
     let mut k = 0;
     let mut send = |job: Job| {
@@ -145,7 +146,7 @@ fn split<R: Read>(
             if eof {
                 break buf.len();
             }
-            if buf.len() >= JOB_BYTES {
+            if buf.len() >= job_bytes {
                 if let Some(p) = memchr::memrchr(b'\n', &buf[searched..]) {
                     break searched + p + 1;
                 }
@@ -157,7 +158,10 @@ fn split<R: Read>(
                 }
             }
             let len = buf.len();
-            buf.resize(len.max(JOB_BYTES - READ_BYTES) + READ_BYTES, 0);
+            buf.resize(
+                len.max(job_bytes.saturating_sub(read_bytes)) + read_bytes,
+                0,
+            );
             let n = loop {
                 match src.read(&mut buf[len..]) {
                     Ok(n) => break Some(n),
@@ -205,8 +209,23 @@ impl<R: BufRead + Send> RecordingReader<R> {
         chunk: &mut RecordingChunk,
         max_rows: usize,
         workers: usize,
+        each: impl FnMut(&mut RecordingChunk, usize, u64) -> bool,
+    ) -> Result<()> {
+        self.for_each_chunk_in_jobs_of(JOB_BYTES, chunk, max_rows, workers, each)
+    }
+
+    /// [`RecordingReader::for_each_chunk`] with jobs of about `job_bytes` bytes of input
+    /// (for tests: small jobs cut small inputs into many, so that their seams are exercised).
+    #[doc(hidden)]
+    pub fn for_each_chunk_in_jobs_of(
+        &mut self,
+        job_bytes: usize,
+        chunk: &mut RecordingChunk,
+        max_rows: usize,
+        workers: usize,
         mut each: impl FnMut(&mut RecordingChunk, usize, u64) -> bool,
     ) -> Result<()> {
+        let job_bytes = job_bytes.max(1);
         let max_rows = max_rows.max(1);
         // serially: the lines read ahead at open (and what cannot be parsed in parallel)
         loop {
@@ -287,7 +306,7 @@ impl<R: BufRead + Send> RecordingReader<R> {
                 free_res.push(ft);
             }
             drop(free_buf_tx);
-            scope.spawn(move || split(src, carry, eof, job_tx, free_buf_rx));
+            scope.spawn(move || split(src, (carry, eof), job_bytes, job_tx, free_buf_rx));
             reset(chunk, sample);
             let mut result = Ok(true);
             'jobs: for k in 0.. {
@@ -328,6 +347,12 @@ impl<R: BufRead + Send> RecordingReader<R> {
                     r += take;
                 }
                 if let Some(mut e) = p.error {
+                    // a chunk filled by the rows before the error is handed on first, as
+                    // `read_chunk` returns it before the call that meets the error
+                    if chunk.len() == max_rows && !each(chunk, max_rows, bytes) {
+                        result = Ok(false);
+                        break;
+                    }
                     shift_line(&mut e, line_no);
                     result = Err(e);
                     break;
