@@ -51,42 +51,71 @@ pub(crate) fn trim_field(mut b: &[u8]) -> &[u8] {
 pub(crate) fn parse_number(cell: &[u8], decimal_comma: bool) -> Option<f64> {
     let b = trim_field(cell);
     let n = b.len();
-    let (neg, mut i) = match b.first() {
-        Some(b'-') => (true, 1),
-        Some(b'+') => (false, 1),
-        _ => (false, 0),
-    };
-    let mut mant: u64 = 0;
-    let int_start = i;
-    while i < n {
-        let d = b[i].wrapping_sub(b'0');
-        if d >= 10 {
-            break;
-        }
-        mant = mant.wrapping_mul(10).wrapping_add(u64::from(d));
-        i += 1;
-    }
-    let int_digits = i - int_start;
-    let mut frac_digits = 0;
-    if i < n && (b[i] == b'.' || (decimal_comma && b[i] == b',')) {
-        i += 1;
-        let frac_start = i;
-        while i < n {
-            let d = b[i].wrapping_sub(b'0');
-            if d >= 10 {
-                break;
-            }
-            mant = mant.wrapping_mul(10).wrapping_add(u64::from(d));
-            i += 1;
-        }
-        frac_digits = i - frac_start;
-    }
+    let Mantissa {
+        neg,
+        mant,
+        int_digits,
+        frac_digits,
+        end: i,
+    } = scan_mantissa(b, decimal_comma);
     let digits = int_digits + frac_digits;
     if i < n || digits == 0 || digits > 19 || mant >= (1u64 << 53) || frac_digits > 22 {
         return parse_number_full(b, decimal_comma);
     }
     let v = mant as f64 / POW10[frac_digits];
     Some(if neg { -v } else { v })
+}
+
+/// The sign and the digits of a cell up to its first non-digit after the optional fraction:
+/// the mantissa as an integer (wrapping past 19 digits: callers check `int_digits +
+/// frac_digits`), the digit counts from positions (not per-digit counters), and where the scan
+/// stopped.
+struct Mantissa {
+    neg: bool,
+    mant: u64,
+    int_digits: usize,
+    frac_digits: usize,
+    end: usize,
+}
+
+/// Scan a trimmed cell's sign, integer and fraction digits (two tight digit loops, shared by
+/// the inline fast path and the full parser; inlined into both).
+#[inline(always)]
+fn scan_mantissa(b: &[u8], decimal_comma: bool) -> Mantissa {
+    let n = b.len();
+    let (neg, mut i) = match b.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    let digits = |mut i: usize, mant: &mut u64| {
+        while i < n {
+            let d = b[i].wrapping_sub(b'0');
+            if d >= 10 {
+                break;
+            }
+            *mant = mant.wrapping_mul(10).wrapping_add(u64::from(d));
+            i += 1;
+        }
+        i
+    };
+    let mut mant: u64 = 0;
+    let int_start = i;
+    i = digits(i, &mut mant);
+    let int_digits = i - int_start;
+    let mut frac_digits = 0;
+    if i < n && (b[i] == b'.' || (decimal_comma && b[i] == b',')) {
+        let frac_start = i + 1;
+        i = digits(frac_start, &mut mant);
+        frac_digits = i - frac_start;
+    }
+    Mantissa {
+        neg,
+        mant,
+        int_digits,
+        frac_digits,
+        end: i,
+    }
 }
 
 /// [`parse_number`] for any cell (already trimmed; trimming again changes nothing): exponents,
@@ -96,36 +125,13 @@ pub(crate) fn parse_number(cell: &[u8], decimal_comma: bool) -> Option<f64> {
 fn parse_number_full(cell: &[u8], decimal_comma: bool) -> Option<f64> {
     let b = trim_field(cell);
     let n = b.len();
-    let (neg, mut i) = match b.first() {
-        Some(b'-') => (true, 1),
-        Some(b'+') => (false, 1),
-        _ => (false, 0),
-    };
-    let mut mant: u64 = 0;
-    let int_start = i;
-    while i < n {
-        let d = b[i].wrapping_sub(b'0');
-        if d >= 10 {
-            break;
-        }
-        mant = mant.wrapping_mul(10).wrapping_add(u64::from(d));
-        i += 1;
-    }
-    let int_digits = i - int_start;
-    let mut frac_digits = 0;
-    if i < n && (b[i] == b'.' || (decimal_comma && b[i] == b',')) {
-        i += 1;
-        let frac_start = i;
-        while i < n {
-            let d = b[i].wrapping_sub(b'0');
-            if d >= 10 {
-                break;
-            }
-            mant = mant.wrapping_mul(10).wrapping_add(u64::from(d));
-            i += 1;
-        }
-        frac_digits = i - frac_start;
-    }
+    let Mantissa {
+        neg,
+        mant,
+        int_digits,
+        frac_digits,
+        end: mut i,
+    } = scan_mantissa(b, decimal_comma);
     if int_digits + frac_digits == 0 {
         return None;
     }
