@@ -10,6 +10,10 @@ use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
+/// Buffer of the spill's writer and reader: writes and reads of at least this many bytes go
+/// straight between the values and the file (one copy instead of two).
+const BUFFER_BYTES: usize = 1 << 16;
+
 /// A temporary binary copy of a recording's channels, written block by block.
 #[derive(Debug)]
 pub struct Spill {
@@ -33,7 +37,8 @@ impl Spill {
         let f = File::create(&path)?;
         Ok(Self {
             path,
-            writer: Some(BufWriter::with_capacity(1 << 20, f)),
+            // small buffers: a block's columns (≈ 0.5 MB each) bypass them, the row counts do not
+            writer: Some(BufWriter::with_capacity(BUFFER_BYTES, f)),
             channels,
             rows: 0,
         })
@@ -58,14 +63,19 @@ impl Spill {
             .expect("spill written before it is read");
         let n = chunk.len();
         w.write_all(&(n as u64).to_le_bytes())?;
-        // straight into the writer's buffer, a few values at a time (no block-sized copy)
-        let mut bytes = [0u8; 8 * 64];
         for c in chunk.values.iter().take(self.channels) {
-            for part in c.chunks(64) {
-                for (b, v) in bytes.chunks_exact_mut(8).zip(part) {
-                    b.copy_from_slice(&v.to_le_bytes());
+            if cfg!(target_endian = "little") {
+                // the values' memory is the file's layout: one copy into the writer
+                w.write_all(bytemuck::cast_slice(c))?;
+            } else {
+                // straight into the writer's buffer, a few values at a time
+                let mut bytes = [0u8; 8 * 64];
+                for part in c.chunks(64) {
+                    for (b, v) in bytes.chunks_exact_mut(8).zip(part) {
+                        b.copy_from_slice(&v.to_le_bytes());
+                    }
+                    w.write_all(&bytes[..8 * part.len()])?;
                 }
-                w.write_all(&bytes[..8 * part.len()])?;
             }
         }
         self.rows += n as u64;
@@ -79,7 +89,7 @@ impl Spill {
         }
         let f = File::open(&self.path)?;
         Ok(SpillReader {
-            r: BufReader::with_capacity(1 << 20, f),
+            r: BufReader::with_capacity(BUFFER_BYTES, f),
             channels: self.channels,
             first: 0,
             bytes: Vec::new(),
@@ -116,15 +126,22 @@ impl SpillReader {
         chunk.first_sample = self.first;
         chunk.time_s.clear();
         chunk.values.resize_with(self.channels, Vec::new);
-        self.bytes.resize(8 * n, 0);
         for c in &mut chunk.values {
-            self.r.read_exact(&mut self.bytes)?;
-            c.clear();
-            c.extend(
-                self.bytes
-                    .chunks_exact(8)
-                    .map(|b| f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]])),
-            );
+            if cfg!(target_endian = "little") {
+                // the file's layout is the values' memory: read straight into them
+                c.clear();
+                c.resize(n, 0.0);
+                self.r.read_exact(bytemuck::cast_slice_mut(c))?;
+            } else {
+                self.bytes.resize(8 * n, 0);
+                self.r.read_exact(&mut self.bytes)?;
+                c.clear();
+                c.extend(
+                    self.bytes.chunks_exact(8).map(|b| {
+                        f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]])
+                    }),
+                );
+            }
         }
         self.first += n as u64;
         Ok(n)

@@ -4,7 +4,10 @@ use super::error::RecordingError;
 use super::header::{
     detect_decimal_comma, detect_delimiter, is_unit_row, key_line, meta_number, split_unit,
 };
-use super::text::{binary_issue, decode, fields, parse_number, trim_field};
+use super::text::{
+    binary_issue, decode, delimiter_ends_numbers, fields, parse_leading_number, parse_number,
+    trim_field,
+};
 use super::{Channel, Format, ReadOptions, RecordingChunk, RecordingInfo};
 use std::collections::VecDeque;
 use std::fs::File;
@@ -834,28 +837,46 @@ impl RowParser<'_> {
     ) -> Result<()> {
         let delim = self.delim;
         let dc = self.dc;
+        let fused = delimiter_ends_numbers(delim, dc);
         let mut n_fields = 0;
-        // the fields of the row by position (as `fields`), each parsed where it lies
+        // the fields of the row by position (as `fields`), each parsed where it lies: a common
+        // number cell in one pass that also finds its end, anything else split off first
         let mut start = 0;
         for j in 0.. {
-            let end = row[start..]
-                .iter()
-                .position(|&c| c == delim)
-                .map_or(row.len(), |k| start + k);
-            let f = &row[start..end];
+            let slot = self.slots.get(j);
             n_fields = j + 1;
-            match self.slots.get(j) {
-                Some(Slot::Skip) => {}
-                Some(&slot) => match parse_number(f, dc) {
-                    Some(v) => match slot {
-                        Slot::Channel(k) => values[k].push(v),
-                        _ => *time = Some(v * self.time_scale),
+            let leading = match slot {
+                Some(Slot::Channel(_) | Slot::Time) if fused => {
+                    parse_leading_number(&row[start..], delim, dc)
+                }
+                _ => None,
+            };
+            let end = if let Some((v, len)) = leading {
+                match slot {
+                    Some(&Slot::Channel(k)) => values[k].push(v),
+                    _ => *time = Some(v * self.time_scale),
+                }
+                start + len
+            } else {
+                let end = row[start..]
+                    .iter()
+                    .position(|&c| c == delim)
+                    .map_or(row.len(), |k| start + k);
+                let f = &row[start..end];
+                match slot {
+                    Some(Slot::Skip) => {}
+                    Some(&slot) => match parse_number(f, dc) {
+                        Some(v) => match slot {
+                            Slot::Channel(k) => values[k].push(v),
+                            _ => *time = Some(v * self.time_scale),
+                        },
+                        None => return Err(self.cell_error(line, row, j, f)),
                     },
-                    None => return Err(self.cell_error(line, row, j, f)),
-                },
-                None if trim_field(f).is_empty() => {}
-                None => return Err(self.field_count_error(line, row)),
-            }
+                    None if trim_field(f).is_empty() => {}
+                    None => return Err(self.field_count_error(line, row)),
+                }
+                end
+            };
             if end == row.len() {
                 break;
             }
