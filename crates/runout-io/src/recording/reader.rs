@@ -590,6 +590,20 @@ impl<R: BufRead> RecordingReader<R> {
         if let Some(b) = &mut self.binary {
             return b.read_chunk(chunk, max_rows);
         }
+        let mut rows = self.read_pending_rows(chunk, max_rows)?;
+        if rows < max_rows && !self.finished {
+            if let Err(e) = self.read_block_rows(chunk, max_rows, &mut rows) {
+                self.finished = true;
+                return Err(e);
+            }
+        }
+        Ok(rows)
+    }
+
+    /// `chunk` emptied for the next rows (text recordings), then filled with the lines read
+    /// ahead at open, up to `max_rows` of them: the rows taken (0 once finished). An error
+    /// finishes the reader.
+    fn read_pending_rows(&mut self, chunk: &mut RecordingChunk, max_rows: usize) -> Result<usize> {
         chunk.first_sample = self.sample;
         chunk.time_s.clear();
         chunk.values.resize_with(self.info.channels.len(), Vec::new);
@@ -605,7 +619,7 @@ impl<R: BufRead> RecordingReader<R> {
         let mut buf = std::mem::take(&mut self.buf);
         let mut rows = 0;
         // the lines read ahead at open, one by one
-        let mut result = loop {
+        let result = loop {
             if rows == max_rows || self.lines.pending.is_empty() {
                 break Ok(());
             }
@@ -626,9 +640,6 @@ impl<R: BufRead> RecordingReader<R> {
             rows += 1;
         };
         self.buf = buf;
-        if result.is_ok() && rows < max_rows {
-            result = self.read_block_rows(chunk, max_rows, &mut rows);
-        }
         if result.is_err() {
             self.finished = true;
         }
