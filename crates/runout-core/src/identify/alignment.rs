@@ -13,12 +13,15 @@
 //!    residual after a linear least-squares solve is a cheap function of θ₀; a grid over ±w and a
 //!    parabola through the best three points give θ₀ to a small fraction of a degree.
 
-use super::model::{coefficient_gradient, force_from_basis, RevolutionModel};
+use super::model::{
+    coefficient_gradient, force_from_basis, grouping, with_grouping, RevolutionModel,
+};
 use super::waveform::{FrameAxis, WaveformCase};
 use crate::angle::wrap_pi;
 use crate::coefficients::CuttingCoefficients;
 use crate::fit::{fourier_coefficient, LinearLsq};
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 use std::f64::consts::TAU;
 
 /// Axial disks for alignment evaluations: 0.1° of helix lag per disk and at least
@@ -147,7 +150,8 @@ fn lsq_rss<const P: usize>(rows: &[[f64; P]], y: &[f64]) -> f64 {
 
 /// θ₀ minimising [`residual_at`] within ±`half_width` (rad) of `start`: a 41-point grid, then a
 /// second 41-point grid over ±2 steps around the best point, then a parabola through the best
-/// point and its neighbours. Returns (θ₀, RSS).
+/// point and its neighbours. The points of a grid are independent: they are costed in parallel
+/// (rayon, one contiguous chunk per thread) and gathered in grid order. Returns (θ₀, RSS).
 pub fn refine_start_angle(
     case: &WaveformCase,
     start: f64,
@@ -161,7 +165,15 @@ pub fn refine_start_angle(
     for _ in 0..2 {
         let step = 2.0 * width / (N - 1) as f64;
         let grid: Vec<f64> = (0..N).map(|i| centre - width + step * i as f64).collect();
-        let rss: Vec<f64> = grid.iter().map(|&t| residual_at(case, t, e, tau)).collect();
+        // independent points: in parallel, gathered in grid order (the same numbers at any
+        // thread count)
+        let g = grouping();
+        let rss: Vec<f64> = grid
+            .par_iter()
+            // (rayon splits a range while half of it is ≥ the minimum: 2 chunks on 2 threads)
+            .with_min_len((N / rayon::current_num_threads()).max(1))
+            .map(|&t| with_grouping(g, || residual_at(case, t, e, tau)))
+            .collect();
         let best = (0..N)
             .min_by(|&a, &b| rss[a].total_cmp(&rss[b]))
             .unwrap_or(N / 2);

@@ -33,7 +33,8 @@ use super::error::IdentifyError;
 use super::frequency::{frequency_estimate, FrequencyEstimate};
 use super::harmonic_fit::{harmonic_fit, ChainFitReport, ChainOptions};
 use super::model::{
-    coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel,
+    coefficient_gradient, force_from_basis, grouping, join_grouped, runout_gradient, with_grouping,
+    BasisSums, GroupingScope, RevolutionModel,
 };
 use super::sine_fit::Estimate;
 use super::waveform::{FrameAxis, WaveformCase};
@@ -41,6 +42,7 @@ use crate::coefficients::CuttingCoefficients;
 use crate::fit::linear_lsq;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// Options of [`full_signal_fit`].
@@ -143,8 +145,9 @@ fn runout_observability(p: &mut Problem<'_>) -> RunoutObservability {
     p.analytic = true;
     p.recompute();
     let jac = p.jacobian();
+    // (the sums stay the analytic ones here: every user recomputes them first — the stage-1
+    // scan and `set_smooth` — so the plain sums are not computed again only to be replaced)
     p.analytic = false;
-    p.recompute();
     let Some(j) = jac else {
         return RunoutObservability::Full;
     };
@@ -336,27 +339,42 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
         // differences stalled LM in the straight-flute edge-skipping round trip), or
         // analytic (smooth part only) for the covariance.
         let kc = self.coefficients();
-        let fd: Vec<DVector<f64>> = (0..nr)
-            .map(|p| {
-                if self.analytic {
-                    return self.analytic_runout_column(p, &kc);
-                }
-                let mut plus = self.clone();
-                plus.x[p] += RUNOUT_STEP_UM;
-                plus.recompute();
-                let fp = plus.raw_residuals();
-                let mut minus = self.clone();
-                minus.x[p] -= RUNOUT_STEP_UM;
-                minus.recompute();
-                let here = minus.raw_residuals();
-                DVector::from_iterator(
-                    fp.len(),
-                    fp.iter()
-                        .zip(&here)
-                        .map(|(a, b)| (a - b) / (2.0 * RUNOUT_STEP_UM)),
-                )
-            })
-            .collect();
+        // (the 2·nr shifted evaluations are independent: in parallel, gathered in order)
+        let fd: Vec<DVector<f64>> = if self.analytic {
+            (0..nr)
+                .map(|p| self.analytic_runout_column(p, &kc))
+                .collect()
+        } else {
+            let g = grouping();
+            let shifted: Vec<Vec<f64>> = (0..2 * nr)
+                .into_par_iter()
+                .with_min_len(nr.max(1))
+                .map(|i| {
+                    let _g = GroupingScope::new(g);
+                    let mut q = self.clone();
+                    let step = if i % 2 == 0 {
+                        RUNOUT_STEP_UM
+                    } else {
+                        -RUNOUT_STEP_UM
+                    };
+                    q.x[i / 2] += step;
+                    q.recompute();
+                    q.raw_residuals()
+                })
+                .collect();
+            shifted
+                .chunks(2)
+                .map(|pm| {
+                    let (fp, here) = (&pm[0], &pm[1]);
+                    DVector::from_iterator(
+                        fp.len(),
+                        fp.iter()
+                            .zip(here)
+                            .map(|(a, b)| (a - b) / (2.0 * RUNOUT_STEP_UM)),
+                    )
+                })
+                .collect()
+        };
         let mut row = 0;
         for (c, case) in self.cases.iter().enumerate() {
             let s = &self.sums[c];
@@ -416,28 +434,31 @@ fn profile_cost(p: &mut Problem<'_>) -> f64 {
 /// Stage 2 of the fit: compass (pattern) search of the runout parameters on the **exact** model's
 /// profile cost (coefficients re-solved linearly at each point). Derivative-free, so the
 /// edge-force steps of the exact model (see [`RUNOUT_STEP_UM`]) cannot stall it; steps from
-/// max(0.5 µm, 5 % of ρ) halved down to 0.005 µm. Returns the number of model evaluations.
+/// max(0.5 µm, 5 % of ρ) halved down to 0.005 µm. Each trial point is costed on a copy of the
+/// problem (the cost depends on the runout only: the coefficients are solved afresh), so the
+/// search can cost a direction's two trial points at once ([`compass_search`]). Returns the
+/// number of model evaluations.
 fn pattern_search(p: &mut Problem<'_>) -> usize {
     let nr = p.n_runout();
+    // (`search_directions` computes p's sums at x0)
     let x0 = p.x.clone();
-    p.set_params(&x0);
     let dirs = search_directions(p);
     let (e, _) = p.runout();
     let step = (0.05 * e[0].hypot(e[1]) * 1e3).max(0.5);
     let start: Vec<f64> = (0..nr).map(|k| x0[k]).collect();
+    let here: &Problem<'_> = p;
     let (best, evals) = compass_search(&start, &dirs, step, 0.005, |t| {
-        let mut x = p.x.clone();
+        let mut q = here.clone();
         for (k, v) in t.iter().enumerate() {
-            x[k] = *v;
+            q.x[k] = *v;
         }
-        p.set_params(&x);
-        profile_cost(p)
+        // (`linear_coefficients` recomputes the sums at the trial runout)
+        profile_cost(&mut q)
     });
-    let mut x = p.x.clone();
     for (k, v) in best.iter().enumerate() {
-        x[k] = *v;
+        p.x[k] = *v;
     }
-    p.set_params(&x);
+    // (`linear_coefficients` recomputes the sums at the best runout)
     profile_cost(p);
     evals
 }
@@ -445,34 +466,53 @@ fn pattern_search(p: &mut Problem<'_>) -> usize {
 /// Compass (pattern) search: from `x0` try ± `step`·d along each direction d, take the first
 /// improvement, halve the step when none improves; stop below `min_step` (µm) or after 600
 /// evaluations. Returns the best point and the number of cost evaluations.
+///
+/// The two trial points of a direction, x + step·d and x − step·d, are costed at once
+/// ([`rayon::join`]; `cost` must depend on its argument only) and the first improvement taken
+/// in that order: the same path, points and costs as trying them one after the other, at any
+/// thread count. A − point costed although the + point improved is not counted in the
+/// evaluations (the serial search would not have costed it).
 pub(crate) fn compass_search(
     x0: &[f64],
     dirs: &[Vec<f64>],
     step0: f64,
     min_step: f64,
-    mut cost: impl FnMut(&[f64]) -> f64,
+    cost: impl Fn(&[f64]) -> f64 + Sync,
 ) -> (Vec<f64>, usize) {
     let mut x = x0.to_vec();
     let mut best = cost(&x);
     let mut step = step0;
     let mut evals = 1;
+    let parallel = rayon::current_num_threads() > 1;
     while step > min_step && evals < 600 {
         let mut moved = false;
         for d in dirs {
-            for sign in [1.0, -1.0] {
-                let trial: Vec<f64> = x
-                    .iter()
+            let trial = |sign: f64| -> Vec<f64> {
+                x.iter()
                     .zip(d)
                     .map(|(v, dv)| v + sign * step * dv)
-                    .collect();
-                let c = cost(&trial);
-                evals += 1;
-                if c < best {
-                    best = c;
-                    x = trial;
-                    moved = true;
-                    break;
-                }
+                    .collect()
+            };
+            let (plus, minus) = (trial(1.0), trial(-1.0));
+            let (cp, cm) = if parallel {
+                join_grouped(|| cost(&plus), || cost(&minus))
+            } else {
+                let cp = cost(&plus);
+                // serially, the − point only when the + point does not improve
+                (cp, if cp < best { f64::NAN } else { cost(&minus) })
+            };
+            evals += 1;
+            if cp < best {
+                best = cp;
+                x = plus;
+                moved = true;
+                continue;
+            }
+            evals += 1;
+            if cm < best {
+                best = cm;
+                x = minus;
+                moved = true;
             }
         }
         if !moved {
@@ -513,8 +553,9 @@ fn search_directions(p: &mut Problem<'_>) -> Vec<Vec<f64>> {
     p.analytic = true;
     p.recompute();
     let jac = p.jacobian();
+    // (the search costs its points on copies that recompute their sums, and then recomputes
+    // p's at the best point: the plain sums at the start are not needed again)
     p.analytic = false;
-    p.recompute();
     let Some(j) = jac else { return axes() };
     let np = j.ncols();
     let jr = j.columns(0, nr).into_owned();
@@ -722,7 +763,8 @@ fn start_values(
 
 /// Stage 1 on the smooth variant of the model (edge forces over the whole engagement window,
 /// continuous in e): a scan of the candidate runouts with the exactly solved coefficients at each,
-/// then LM from the best (and from the second best when its cost is within 2×) — with edge
+/// then LM from the best (and from the second best when its cost is within 2×; the candidates
+/// and the two solves are independent and run in parallel, in a fixed order) — with edge
 /// skipping (large ρ, K = 2) the cost has local minima the frequency estimate alone can fall into.
 /// Stage 2: derivative-free pattern search on the exact model (edge forces only where h > 0, as
 /// the simulation) from the stage-1 solution. With straight flutes the exact model's residuals
@@ -733,25 +775,52 @@ fn local_fit<'a>(
     candidates: Vec<[f64; 2]>,
 ) -> Result<(Problem<'a>, levenberg_marquardt::MinimizationReport<f64>), IdentifyError> {
     problem.set_smooth(true);
-    let mut scored: Vec<(f64, DVector<f64>)> = Vec::with_capacity(candidates.len());
-    for e in candidates {
-        problem.x.fill(0.0);
-        problem.set_runout(e);
-        if linear_coefficients(&mut problem).is_ok() {
-            if let Some(r) = problem.residuals() {
-                scored.push((r.norm_squared(), problem.x.clone()));
-            }
-        }
-    }
+    // the candidates are independent (each starts from zero coefficients, solved afresh): in
+    // parallel, gathered in candidate order
+    let here = &problem;
+    let g = grouping();
+    let mut scored: Vec<(f64, DVector<f64>)> = candidates
+        .par_iter()
+        .map_init(
+            || here.clone(),
+            |q, &e| {
+                let _g = GroupingScope::new(g);
+                q.x.fill(0.0);
+                q.set_runout(e);
+                if linear_coefficients(q).is_ok() {
+                    if let Some(r) = q.residuals() {
+                        return Some((r.norm_squared(), q.x.clone()));
+                    }
+                }
+                None
+            },
+        )
+        .collect::<Vec<_>>()
+        .into_iter()
+        .flatten()
+        .collect();
     scored.sort_by(|a, b| a.0.total_cmp(&b.0));
     let lm = || LevenbergMarquardt::new().with_patience(200);
     let mut best: Option<(Problem<'_>, levenberg_marquardt::MinimizationReport<f64>)> = None;
-    // second start only when its scan cost is comparable (within 2×) to the best one's
+    // second start only when its scan cost is comparable (within 2×) to the best one's; the
+    // two solves are independent: in parallel, compared in start order
     let best_cost = scored.first().map(|c| c.0).unwrap_or(f64::INFINITY);
-    for (_, x) in scored.iter().take(2).filter(|c| c.0 <= 2.0 * best_cost) {
-        let mut start = problem.clone();
-        start.set_params(x);
-        let (done, report) = lm().minimize(start);
+    let runs: Vec<_> = scored
+        .iter()
+        .take(2)
+        .filter(|c| c.0 <= 2.0 * best_cost)
+        .collect::<Vec<_>>()
+        .into_par_iter()
+        .with_max_len(1)
+        .map(|(_, x)| {
+            with_grouping(g, || {
+                let mut start = problem.clone();
+                start.set_params(x);
+                lm().minimize(start)
+            })
+        })
+        .collect();
+    for (done, report) in runs {
         let better = best
             .as_ref()
             .is_none_or(|(_, r)| report.objective_function < r.objective_function);
@@ -760,7 +829,10 @@ fn local_fit<'a>(
         }
     }
     let best = best.map(|(mut p, r1)| {
-        p.set_smooth(false);
+        // (the exact model's sums are first computed by `pattern_search`, with derivatives)
+        for m in &mut p.models {
+            m.edge_in_window = false;
+        }
         let evals = pattern_search(&mut p);
         let mut r = r1;
         r.number_of_evaluations += evals;

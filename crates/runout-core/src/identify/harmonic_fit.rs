@@ -31,7 +31,9 @@ use super::full_signal::{
     candidate_runouts, compass_search, fit_summary, FitSummaryInput, FullSignalFit,
     FullSignalOptions, RunoutObservability, NAMES, RUNOUT_STEP_UM,
 };
-use super::model::{coefficient_gradient, BasisSums, RevolutionModel, NB};
+use super::model::{
+    coefficient_gradient, grouping, join_grouped, BasisSums, GroupingScope, RevolutionModel, NB,
+};
 use super::sine_fit::Estimate;
 use super::waveform::{FrameAxis, WaveformCase};
 use crate::chain::{AxisChain, Complex64, MeasuringChain, SensorMode};
@@ -251,12 +253,16 @@ fn refine_on_exact_model(
         };
         let x_runout: Vec<f64> = (0..nr).map(|i| p.x[i]).collect();
         // 0.02 µm: a tenth of the smallest runout SE of the round trips (0.18 µm)
+        // each trial point on a copy of p: its cost depends on the runout only (the
+        // coefficients are solved afresh), so the search may cost two points at once
+        let here: &HarmonicProblem<'_> = p;
         let (xr, e) = compass_search(&x_runout, &dirs, step, 0.02, |t| {
+            let mut q = here.clone();
             for (i, v) in t.iter().enumerate() {
-                p.x[i] = *v;
+                q.x[i] = *v;
             }
-            p.recompute();
-            p.profile_cost()
+            q.recompute();
+            q.profile_cost()
         });
         evals += e;
         for (i, v) in xr.iter().enumerate() {
@@ -817,6 +823,31 @@ impl HarmonicProblem<'_> {
     }
 }
 
+impl HarmonicProblem<'_> {
+    /// The residuals at x ± [`RUNOUT_STEP_UM`] along each of the first `cols` runout
+    /// parameters, in the order (+, −) per parameter: only the basis changes, the rest of x is
+    /// kept. The 2·`cols` evaluations are independent: in parallel (two contiguous halves on
+    /// two threads), gathered in order.
+    fn runout_differences(&self, cols: usize) -> Vec<Vec<f64>> {
+        let g = grouping();
+        (0..2 * cols)
+            .into_par_iter()
+            .with_min_len(cols.max(1))
+            .map(|i| {
+                let _g = GroupingScope::new(g);
+                let mut x = self.x.clone();
+                x[i / 2] += if i % 2 == 0 {
+                    RUNOUT_STEP_UM
+                } else {
+                    -RUNOUT_STEP_UM
+                };
+                let (e, t) = self.runout_of(&x);
+                self.residual_vec_with(&self.tables_for(&self.basis_at(e, t)))
+            })
+            .collect()
+    }
+}
+
 impl LeastSquaresProblem<f64, Dyn, Dyn> for HarmonicProblem<'_> {
     type ResidualStorage = Owned<f64, Dyn>;
     type JacobianStorage = Owned<f64, Dyn, Dyn>;
@@ -846,21 +877,14 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for HarmonicProblem<'_> {
         } else {
             self.n_runout()
         };
-        // (the residuals at the shifted runout: only the basis changes, the rest of x is kept)
-        let shifted = |p: usize, step: f64| {
-            let mut x = self.x.clone();
-            x[p] += step;
-            let (e, t) = self.runout_of(&x);
-            self.residual_vec_with(&self.tables_for(&self.basis_at(e, t)))
-        };
-        for p in 0..runout_cols {
-            let plus = shifted(p, RUNOUT_STEP_UM);
-            let minus = shifted(p, -RUNOUT_STEP_UM);
-            for (r, (a, b)) in plus.iter().zip(minus).enumerate() {
+        // (the runout differences and the tables at x are independent: in parallel)
+        let (cols, tables) =
+            join_grouped(|| self.runout_differences(runout_cols), || self.tables());
+        for (p, pm) in cols.chunks(2).enumerate() {
+            for (r, (a, b)) in pm[0].iter().zip(&pm[1]).enumerate() {
                 j[(r, p)] = (a - b) / (2.0 * RUNOUT_STEP_UM);
             }
         }
-        let tables = self.tables();
         let design = self.coefficient_design(&tables);
         j.columns_mut(self.coef_start(), self.coef_idx.len())
             .copy_from(&design);
@@ -1089,26 +1113,93 @@ fn grid_costs(
 /// only — so each candidate's model is evaluated once (identical results, a third of the work).
 type BasisCache = Vec<(Vec<f64>, Vec<Vec<Vec<Complex64>>>)>;
 
-/// Profile cost at each candidate runout vector (the rest of x as it is), best first.
+/// Profile cost at each candidate runout vector (the rest of x as it is), best first, and p
+/// left as the serial loop over the candidates leaves it (the last candidate's runout and
+/// basis, the coefficients of the last successful linear solve). The candidates are
+/// independent (the coefficients are solved afresh at each): their bases and costs are
+/// evaluated in parallel (rayon, one clone of p per task) and gathered in candidate order —
+/// the same numbers at any thread count.
 fn scan_runouts(
     p: &mut HarmonicProblem<'_>,
     candidates: &[[f64; 2]],
     cache: &mut BasisCache,
 ) -> Vec<(f64, DVector<f64>)> {
-    let mut scored: Vec<(f64, DVector<f64>)> = Vec::new();
+    /// Per candidate: its key, the basis when not cached, the cost, x after the solve and
+    /// whether the solve succeeded.
+    type Evaluated = (
+        Vec<f64>,
+        Option<Vec<Vec<Vec<Complex64>>>>,
+        f64,
+        DVector<f64>,
+        bool,
+    );
     let nr = p.n_runout();
-    for &e in candidates {
-        p.set_runout(e);
-        let key: Vec<f64> = (0..nr).map(|i| p.x[i]).collect();
-        if let Some((_, b)) = cache.iter().find(|(k, _)| *k == key) {
-            p.basis.clone_from(b);
-        } else {
-            p.recompute();
-            cache.push((key, p.basis.clone()));
+    let (c0, nk) = (p.coef_start(), p.coef_idx.len());
+    let shared: &HarmonicProblem<'_> = p;
+    let cached: &BasisCache = cache;
+    let g = grouping();
+    let evaluated: Vec<Evaluated> = candidates
+        .par_iter()
+        .map_init(
+            || shared.clone(),
+            |q, &e| {
+                let _g = GroupingScope::new(g);
+                q.set_runout(e);
+                let key: Vec<f64> = (0..nr).map(|i| q.x[i]).collect();
+                let fresh = match cached.iter().find(|(k, _)| *k == key) {
+                    Some((_, b)) => {
+                        q.basis.clone_from(b);
+                        None
+                    }
+                    None => {
+                        q.recompute();
+                        Some(q.basis.clone())
+                    }
+                };
+                let tables = q.tables();
+                let solved = q.linear_coefficients_with(&tables).is_ok();
+                let c = if solved {
+                    q.residual_vec_with(&tables).iter().map(|r| r * r).sum()
+                } else {
+                    f64::INFINITY
+                };
+                (key, fresh, c, q.x.clone(), solved)
+            },
+        )
+        .collect();
+    let mut scored: Vec<(f64, DVector<f64>)> = Vec::new();
+    let mut last_kc: Option<Vec<f64>> = None;
+    for (key, fresh, c, x, solved) in evaluated {
+        // the cache as the serial loop fills it (a key repeated among the candidates is
+        // stored once, with the basis of its first evaluation: the same values)
+        let basis = match fresh {
+            Some(b) => match cache.iter().find(|(k, _)| *k == key) {
+                Some((_, b0)) => b0.clone(),
+                None => {
+                    cache.push((key.clone(), b.clone()));
+                    b
+                }
+            },
+            None => cache
+                .iter()
+                .find(|(k, _)| *k == key)
+                .map(|(_, b)| b.clone())
+                .unwrap_or_default(),
+        };
+        if solved {
+            last_kc = Some((0..nk).map(|i| x[c0 + i]).collect());
         }
-        let c = p.profile_cost();
+        for (i, v) in key.iter().enumerate() {
+            p.x[i] = *v;
+        }
+        p.basis = basis;
         if c.is_finite() {
-            scored.push((c, p.x.clone()));
+            scored.push((c, x));
+        }
+    }
+    if let Some(kc) = last_kc {
+        for (i, v) in kc.iter().enumerate() {
+            p.x[c0 + i] = *v;
         }
     }
     scored.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -1313,11 +1404,20 @@ pub(crate) fn harmonic_fit(
         HarmonicProblem<'_>,
         levenberg_marquardt::MinimizationReport<f64>,
     )> = None;
-    for (_, x) in &starts {
-        let mut start = p.clone();
-        start.x.copy_from(x);
-        start.recompute();
-        let (done, report) = LevenbergMarquardt::new().with_patience(200).minimize(start);
+    // (the solves from the starts are independent: in parallel, compared in start order)
+    let g = grouping();
+    let runs: Vec<_> = starts
+        .par_iter()
+        .with_max_len(1)
+        .map(|(_, x)| {
+            let _g = GroupingScope::new(g);
+            let mut start = p.clone();
+            start.x.copy_from(x);
+            start.recompute();
+            LevenbergMarquardt::new().with_patience(200).minimize(start)
+        })
+        .collect();
+    for (done, report) in runs {
         if best
             .as_ref()
             .is_none_or(|(_, r)| report.objective_function < r.objective_function)
@@ -1338,12 +1438,25 @@ pub(crate) fn harmonic_fit(
     // Covariance: Jacobian on the smooth model at the solution (see the time-domain fit).
     // (runout columns from the smooth model: the exact model's differences also catch its
     // edge-force steps, which carry no information per sample; the rest from the exact model).
+    // (the exact model's Jacobian without its runout columns, which the smooth model's replace,
+    // and the smooth model's runout differences, which do not need its basis at x: in parallel)
+    let mut exact = p.clone();
+    exact.freeze_runout = true;
     let mut smooth = p.clone();
-    smooth.set_smooth(true);
+    for m in &mut smooth.models {
+        m.edge_in_window = true;
+    }
     let singular = || IdentifyError::singular("chain fit", "non-finite Jacobian");
-    let mut jac = p.jacobian().ok_or_else(singular)?;
-    let js = smooth.jacobian().ok_or_else(singular)?;
-    jac.columns_mut(0, nr).copy_from(&js.columns(0, nr));
+    let (jac, smooth_cols) = join_grouped(|| exact.jacobian(), || smooth.runout_differences(nr));
+    let mut jac = jac.ok_or_else(singular)?;
+    for (c, pm) in smooth_cols.chunks(2).enumerate() {
+        for (r, (a, b)) in pm[0].iter().zip(&pm[1]).enumerate() {
+            jac[(r, c)] = (a - b) / (2.0 * RUNOUT_STEP_UM);
+        }
+    }
+    if !jac.iter().all(|v| v.is_finite()) {
+        return Err(singular());
+    }
     let res = DVector::from_vec(raw.clone());
     let groups = harmonic_groups(&p.data.iter().map(|d| d.kmax).collect::<Vec<_>>(), &{
         cases

@@ -142,7 +142,8 @@ impl RevolutionModel {
         self.compute(e, tau, 0)
     }
 
-    /// Samples are independent: evaluated in parallel (rayon), `np` derivatives per sample.
+    /// The sums with `np` derivatives per sample (the flat kernel on a cylinder, rows 6–9
+    /// filled from rows 0–3).
     fn compute(&self, e: [f64; 2], tau: [f64; 2], np: usize) -> BasisSums {
         if self.table.is_flat() {
             let mut s = self.compute_kernel::<false>(e, tau, np);
@@ -181,7 +182,8 @@ impl RevolutionModel {
     }
 
     /// The shared kernel ([`crate::force`]'s `kernel` module): the arc chip with exact radii
-    /// and the gradient of its active term, disks in parallel (rayon) and summed.
+    /// and the gradient of its active term, disks in blocks summed in a fixed grouping (in
+    /// parallel only for a very large model, see [`PARALLEL_WORK`]).
     fn compute_kernel<const GENERAL: bool>(
         &self,
         e: [f64; 2],
@@ -234,7 +236,9 @@ impl RevolutionModel {
         // on the threads. The halves run in parallel only when the work is large enough to
         // repay waking the pool's threads.
         let acc = if self.disks >= 8 {
-            let outside = rayon::current_thread_index().is_none();
+            // the grouping of the caller that started the fit, also in the tasks it runs in
+            // parallel (see [`grouping`])
+            let outside = grouping();
             let parallel = rayon::current_num_threads() > 1 && self.disks * n >= PARALLEL_WORK;
             split_sum(0..self.disks, 1, false, outside, parallel, &run)
         } else {
@@ -477,9 +481,64 @@ impl RevolutionModel {
     }
 }
 
-/// Disk blocks × grid samples from which [`split_sum`] runs the halves in parallel (below, a
-/// compute takes tens of µs, the order of waking the pool's threads).
-const PARALLEL_WORK: usize = 16_384;
+thread_local! {
+    /// The grouping of [`split_sum`] set for the tasks of a parallel section ([`with_grouping`]).
+    static CALLER_OUTSIDE: std::cell::Cell<Option<bool>> = const { std::cell::Cell::new(None) };
+}
+
+/// Whether the sums computed now take the grouping of a call from outside the rayon pool
+/// ([`split_sum`]'s `outside`): the value [`with_grouping`] set on this thread, else whether
+/// this thread is outside the pool. A fit that costs independent points in parallel reads it
+/// once in its serial step and runs each task under [`with_grouping`] with it, so a point's
+/// sums are those the serial step would compute, bit for bit, wherever the task runs.
+pub(crate) fn grouping() -> bool {
+    CALLER_OUTSIDE
+        .with(|c| c.get())
+        .unwrap_or_else(|| rayon::current_thread_index().is_none())
+}
+
+/// [`grouping`] = `outside` on this thread while the value lives (the previous setting is
+/// restored when it is dropped, also on a panic).
+pub(crate) struct GroupingScope(Option<bool>);
+
+impl GroupingScope {
+    pub(crate) fn new(outside: bool) -> Self {
+        GroupingScope(CALLER_OUTSIDE.with(|c| c.replace(Some(outside))))
+    }
+}
+
+impl Drop for GroupingScope {
+    fn drop(&mut self) {
+        CALLER_OUTSIDE.with(|c| c.set(self.0));
+    }
+}
+
+/// Runs `f` with [`grouping`] = `outside` on this thread ([`GroupingScope`]).
+pub(crate) fn with_grouping<R>(outside: bool, f: impl FnOnce() -> R) -> R {
+    let _scope = GroupingScope::new(outside);
+    f()
+}
+
+/// [`rayon::join`] of `a` and `b`, both with the caller's [`grouping`].
+pub(crate) fn join_grouped<A, B, RA, RB>(a: A, b: B) -> (RA, RB)
+where
+    A: FnOnce() -> RA + Send,
+    B: FnOnce() -> RB + Send,
+    RA: Send,
+    RB: Send,
+{
+    let g = grouping();
+    rayon::join(|| with_grouping(g, a), || with_grouping(g, b))
+}
+
+/// Disk blocks × grid samples from which [`split_sum`] runs the halves in parallel. The fits
+/// use the second core at a coarser grain (trial points, grid candidates and difference
+/// columns costed in parallel: `full_signal`, `harmonic_fit`, `alignment`); at their sizes
+/// (e.g. 133 disks × 185 or 740 samples, 0.1–1 ms per compute) splitting one compute across
+/// the threads cost more than it saved (waking the pool's threads from the serial steps:
+/// 2 threads were slower than 1 on the `identify` bench head job, about a quarter of the fits'
+/// CPU in futex and scheduler calls). Only a very large model is still split in parallel.
+const PARALLEL_WORK: usize = 1 << 20;
 
 /// `run` over `disks`, split in halves (at len/2) and summed left + right, with the decisions
 /// of rayon's adaptive splitter (`splits` starts at the pool's thread count and halves per
