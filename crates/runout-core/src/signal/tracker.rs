@@ -245,12 +245,18 @@ impl PhaseTracker {
                 knots,
             } => {
                 let dt = 1.0 / fs;
-                for i in 0..c.len() {
-                    let rel = (start + i as u64) as f64 * dt - from;
+                let component = self.component;
+                let rel_of = |i: usize| (start + i as u64) as f64 * dt - from;
+                let block_of = |rel: f64| (rel * *rev_s).floor() as u64;
+                let n = c.len();
+                let mut i = 0;
+                while i < n {
+                    let rel = rel_of(i);
                     if rel < 0.0 {
+                        i += 1;
                         continue;
                     }
-                    let b = (rel * *rev_s).floor() as u64;
+                    let b = block_of(rel);
                     if b >= *blocks {
                         break;
                     }
@@ -263,12 +269,30 @@ impl PhaseTracker {
                         let a = -TAU * (*f_tp * rel).fract();
                         *ph = (a.cos(), a.sin());
                     }
-                    let x = self.component.of(c.force(i));
-                    acc.0 += x * ph.0;
-                    acc.1 += x * ph.1;
-                    *tsum += rel;
-                    *count += 1;
-                    *ph = (ph.0 * rot.0 - ph.1 * rot.1, ph.0 * rot.1 + ph.1 * rot.0);
+                    // the samples of this chunk in block b: the block index is non-decreasing
+                    // in the sample (each step of rel_of and block_of is monotone, rounding
+                    // included), so its end is found by bisection on the same expressions and
+                    // the samples up to it skip the per-sample block test (issue 18: the
+                    // pass's loop ≈ 2× faster, the same operations on each sample)
+                    let (mut lo, mut hi) = (i + 1, n);
+                    while lo < hi {
+                        let mid = lo + (hi - lo) / 2;
+                        if block_of(rel_of(mid)) == b {
+                            lo = mid + 1;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    for j in i..lo {
+                        let rel = rel_of(j);
+                        let x = component.of(c.force(j));
+                        acc.0 += x * ph.0;
+                        acc.1 += x * ph.1;
+                        *tsum += rel;
+                        *count += 1;
+                        *ph = (ph.0 * rot.0 - ph.1 * rot.1, ph.0 * rot.1 + ph.1 * rot.0);
+                    }
+                    i = lo;
                 }
             }
             Mode::Pulse {
