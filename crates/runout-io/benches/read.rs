@@ -26,6 +26,24 @@ fn generate(rows: usize) -> Vec<u8> {
     s.into_bytes()
 }
 
+/// The same recording as [`generate`] written in scientific notation (`1.5034e2`), as some
+/// acquisition programs export it: every cell takes the parser's exponent path.
+fn generate_scientific(rows: usize) -> Vec<u8> {
+    let mut s = String::from("time_s,fx_N,fy_N,fz_N,mz_Nm\n");
+    for k in 0..rows {
+        let t = k as f64 / 50_000.0;
+        let a = (t * 1083.0).sin();
+        s += &format!(
+            "{t:.5e},{:.4e},{:.4e},{:.4e},{:.4e}\n",
+            150.0 * a,
+            -80.0 * (t * 2166.0).cos(),
+            12.5 * a * a,
+            0.35 * a
+        );
+    }
+    s.into_bytes()
+}
+
 fn read_all_ours(bytes: &[u8]) -> f64 {
     let mut r = RecordingReader::from_bytes("bench.csv", bytes, &ReadOptions::new()).unwrap();
     let mut c = RecordingChunk::default();
@@ -195,6 +213,15 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("csv_crate_str_parse", |b| {
         b.iter(|| black_box(read_all_csv_crate(black_box(&bytes))))
+    });
+    g.finish();
+    let sci = generate_scientific(400_000);
+    assert_eq!(read_all_ours(&sci), read_all_csv_crate(&sci));
+    let mut g = c.benchmark_group("parse_csv_5col_scientific");
+    g.throughput(Throughput::Bytes(sci.len() as u64));
+    g.sample_size(10);
+    g.bench_function("runout_reader", |b| {
+        b.iter(|| black_box(read_all_ours(black_box(&sci))))
     });
     g.finish();
 }

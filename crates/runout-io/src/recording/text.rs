@@ -45,33 +45,27 @@ pub(crate) fn trim_field(mut b: &[u8]) -> &[u8] {
 /// then applies as described in the module docs, anything else goes to [`slow_parse`].
 ///
 /// The common cell (digits, an optional fraction, no exponent, at most 19 digits, a mantissa
-/// below 2⁵³) is parsed inline; anything else goes to [`parse_number_full`], which gives the
-/// same result for the common cells (issue 18: the fast path inlined into the row loop).
+/// below 2⁵³) is parsed inline ([`Mantissa::fast_value`]); anything else goes on from the same
+/// scan in [`number_from`] (issue 18: the fast path inlined into the row loop, the digits
+/// scanned once for every cell).
 #[inline(always)]
 pub(crate) fn parse_number(cell: &[u8], decimal_comma: bool) -> Option<f64> {
     let b = trim_field(cell);
-    let n = b.len();
-    let Mantissa {
-        neg,
-        mant,
-        int_digits,
-        frac_digits,
-        end: i,
-    } = scan_mantissa(b, decimal_comma);
-    let digits = int_digits + frac_digits;
-    if i < n || digits == 0 || digits > 19 || mant >= (1u64 << 53) || frac_digits > 22 {
-        return parse_number_full(b, decimal_comma);
+    let m = scan_mantissa(b, decimal_comma);
+    match m.fast_value() {
+        Some(v) if m.end == b.len() => Some(v),
+        _ => number_from(b, m, decimal_comma),
     }
-    let v = mant as f64 / POW10[frac_digits];
-    Some(if neg { -v } else { v })
 }
 
 /// A number cell at the start of `rest` (a row from a cell's first byte on) that ends at the
 /// delimiter `delim` or at the end of `rest`, parsed in the same pass that finds its end: the
-/// value and the cell's length, or `None` when the cell is anything but the common form (blanks,
-/// quotes, an exponent, more than 19 digits, text — the caller then splits the cell off and
-/// parses it with [`parse_number`], which gives the same value for every cell accepted here).
-/// One pass over the bytes instead of a delimiter search followed by the digit scan (issue 18).
+/// value and the cell's length. The digits are scanned once: a common cell (sign, digits,
+/// fraction) ends at the delimiter and is done; one with an exponent goes on from where the scan
+/// stopped ([`number_from`]). `None` when the cell is not a clean number (leading or trailing
+/// blanks, quotes, text, an invalid form): the caller then splits the cell off and parses it
+/// with [`parse_number`], which gives the same value for every cell accepted here (issue 18: one
+/// pass over the bytes instead of a delimiter search followed by the digit scan).
 ///
 /// The caller must not use it when `delim` can be part of a number (a digit, a sign, `.`, or
 /// `,` with decimal commas): see [`delimiter_ends_numbers`].
@@ -81,20 +75,38 @@ pub(crate) fn parse_leading_number(
     delim: u8,
     decimal_comma: bool,
 ) -> Option<(f64, usize)> {
-    let Mantissa {
-        neg,
-        mant,
-        int_digits,
-        frac_digits,
-        end,
-    } = scan_mantissa(rest, decimal_comma);
-    let digits = int_digits + frac_digits;
-    let ends = end == rest.len() || rest[end] == delim;
-    if !ends || digits == 0 || digits > 19 || mant >= (1u64 << 53) || frac_digits > 22 {
+    let m = scan_mantissa(rest, decimal_comma);
+    let stop = m.end;
+    if stop == rest.len() || rest[stop] == delim {
+        return m.fast_value().map(|v| (v, stop));
+    }
+    leading_number_from(rest, delim, decimal_comma, m)
+}
+
+/// [`parse_leading_number`] for a cell whose digits did not reach the delimiter (an exponent):
+/// its end is searched from where the scan stopped, and the cell parsed on from there when it
+/// is already trimmed (it starts with a digit, a sign or a point, so only its end can hold
+/// blanks or a quote).
+#[cold]
+#[inline(never)]
+fn leading_number_from(
+    rest: &[u8],
+    delim: u8,
+    decimal_comma: bool,
+    m: Mantissa,
+) -> Option<(f64, usize)> {
+    if m.int_digits + m.frac_digits == 0 {
         return None;
     }
-    let v = mant as f64 / POW10[frac_digits];
-    Some((if neg { -v } else { v }, end))
+    let end = rest[m.end..]
+        .iter()
+        .position(|&c| c == delim)
+        .map_or(rest.len(), |k| m.end + k);
+    let cell = &rest[..end];
+    if matches!(cell.last(), Some(b' ' | b'\t' | b'\r' | b'"')) {
+        return None;
+    }
+    number_from(cell, m, decimal_comma).map(|v| (v, end))
 }
 
 /// Whether `delim` can only end a number (not be part of one), so [`parse_leading_number`] may
@@ -117,6 +129,21 @@ struct Mantissa {
     int_digits: usize,
     frac_digits: usize,
     end: usize,
+}
+
+impl Mantissa {
+    /// Clinger's fast path (module docs): `±mant / 10^frac_digits` when there are 1–19 digits,
+    /// the mantissa is below 2⁵³ and the power of ten at most 10²² — correctly rounded, as both
+    /// operands are exact. `None` otherwise (the caller goes on with [`number_from`]).
+    #[inline(always)]
+    fn fast_value(&self) -> Option<f64> {
+        let digits = self.int_digits + self.frac_digits;
+        if digits == 0 || digits > 19 || self.mant >= (1u64 << 53) || self.frac_digits > 22 {
+            return None;
+        }
+        let v = self.mant as f64 / POW10[self.frac_digits];
+        Some(if self.neg { -v } else { v })
+    }
 }
 
 /// Scan a trimmed cell's sign, integer and fraction digits (two tight digit loops, shared by
@@ -159,12 +186,11 @@ fn scan_mantissa(b: &[u8], decimal_comma: bool) -> Mantissa {
     }
 }
 
-/// [`parse_number`] for any cell (already trimmed; trimming again changes nothing): exponents,
+/// The rest of [`parse_number`] for a trimmed cell `b` whose mantissa scan gave `m`: exponents,
 /// long mantissas and rejections.
 #[cold]
 #[inline(never)]
-fn parse_number_full(cell: &[u8], decimal_comma: bool) -> Option<f64> {
-    let b = trim_field(cell);
+fn number_from(b: &[u8], m: Mantissa, decimal_comma: bool) -> Option<f64> {
     let n = b.len();
     let Mantissa {
         neg,
@@ -172,7 +198,7 @@ fn parse_number_full(cell: &[u8], decimal_comma: bool) -> Option<f64> {
         int_digits,
         frac_digits,
         end: mut i,
-    } = scan_mantissa(b, decimal_comma);
+    } = m;
     if int_digits + frac_digits == 0 {
         return None;
     }
@@ -424,9 +450,18 @@ mod tests {
             parse_leading_number(b"-1,25;7", b';', true),
             Some((-1.25, 5))
         );
-        // blanks, quotes, exponents, text and empty cells are left to the split-and-parse path
+        // exponents go on from the digit scan (the scientific exports of some programs)
+        assert_eq!(
+            parse_leading_number(b"-1.5e3,2", b',', false),
+            Some((-1500.0, 6))
+        );
+        assert_eq!(
+            parse_leading_number(b"2,5E-2;1", b';', true),
+            Some((0.025, 6))
+        );
+        // blanks, quotes, text, invalid forms and empty cells are left to the split-and-parse path
         for rest in [
-            " 1,2", "\"1\",2", "1e3,2", "1 ,2", "x,2", ",2", "", "-,2", "1\r",
+            " 1,2", "\"1\",2", "1e3 ,2", "1 ,2", "x,2", ",2", "", "-,2", "1\r", "1.2.3,4", "1e,2",
         ] {
             assert_eq!(
                 parse_leading_number(rest.as_bytes(), b',', false),
