@@ -9,37 +9,25 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use runout_io::recording::{ReadOptions, RecordingChunk, RecordingReader};
 use std::hint::black_box;
 
-/// A 50 kHz recording: time + 4 force-like channels with 4–6 significant digits.
-fn generate(rows: usize) -> Vec<u8> {
+/// A 50 kHz recording: time + 4 force-like channels with 4–6 significant digits, in fixed
+/// notation or (`scientific`) in scientific notation (`1.5034e2`) as some acquisition programs
+/// export it — then every cell takes the parser's exponent path.
+fn generate(rows: usize, scientific: bool) -> Vec<u8> {
     let mut s = String::from("time_s,fx_N,fy_N,fz_N,mz_Nm\n");
     for k in 0..rows {
         let t = k as f64 / 50_000.0;
         let a = (t * 1083.0).sin();
-        s += &format!(
-            "{t:.5},{:.3},{:.3},{:.3},{:.4}\n",
+        let (fx, fy, fz, mz) = (
             150.0 * a,
             -80.0 * (t * 2166.0).cos(),
             12.5 * a * a,
-            0.35 * a
+            0.35 * a,
         );
-    }
-    s.into_bytes()
-}
-
-/// The same recording as [`generate`] written in scientific notation (`1.5034e2`), as some
-/// acquisition programs export it: every cell takes the parser's exponent path.
-fn generate_scientific(rows: usize) -> Vec<u8> {
-    let mut s = String::from("time_s,fx_N,fy_N,fz_N,mz_Nm\n");
-    for k in 0..rows {
-        let t = k as f64 / 50_000.0;
-        let a = (t * 1083.0).sin();
-        s += &format!(
-            "{t:.5e},{:.4e},{:.4e},{:.4e},{:.4e}\n",
-            150.0 * a,
-            -80.0 * (t * 2166.0).cos(),
-            12.5 * a * a,
-            0.35 * a
-        );
+        s += &if scientific {
+            format!("{t:.5e},{fx:.4e},{fy:.4e},{fz:.4e},{mz:.4e}\n")
+        } else {
+            format!("{t:.5},{fx:.3},{fy:.3},{fz:.3},{mz:.4}\n")
+        };
     }
     s.into_bytes()
 }
@@ -195,7 +183,7 @@ fn read_all_csv_crate(bytes: &[u8]) -> f64 {
 }
 
 fn bench(c: &mut Criterion) {
-    let bytes = generate(400_000);
+    let bytes = generate(400_000, false);
     assert_eq!(read_all_ours(&bytes), read_all_csv_crate(&bytes));
     assert_eq!(read_all_ours(&bytes), read_all_old_line_copy_path(&bytes));
     assert_eq!(read_all_ours(&bytes), read_all_ours_2_threads(&bytes));
@@ -215,7 +203,7 @@ fn bench(c: &mut Criterion) {
         b.iter(|| black_box(read_all_csv_crate(black_box(&bytes))))
     });
     g.finish();
-    let sci = generate_scientific(400_000);
+    let sci = generate(400_000, true);
     assert_eq!(read_all_ours(&sci), read_all_csv_crate(&sci));
     let mut g = c.benchmark_group("parse_csv_5col_scientific");
     g.throughput(Throughput::Bytes(sci.len() as u64));

@@ -16,10 +16,15 @@ use common::*;
 
 /// Run `runout ARGS` from the repository root; its stdout with `tmp` replaced by `[TMP]`.
 fn run(args: &[&str], tmp: &Path) -> String {
+    run_on_threads(args, tmp, "1")
+}
+
+/// [`run`] on `threads` rayon threads.
+fn run_on_threads(args: &[&str], tmp: &Path, threads: &str) -> String {
     let root = example("..");
     let out = runout()
         .current_dir(&root)
-        .env("RAYON_NUM_THREADS", "1")
+        .env("RAYON_NUM_THREADS", threads)
         .args(args)
         .output()
         .unwrap();
@@ -98,21 +103,21 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
+/// `runout identify` on the bundled example, JSON to stdout.
+const IDENTIFY_EXAMPLE: [&str; 7] = [
+    "identify",
+    "examples/identify/cut_fz0.05.txt",
+    "examples/identify/cut_fz0.08.txt",
+    "--config",
+    "examples/identify/cut.toml",
+    "--json",
+    "-",
+];
+
 #[test]
 fn identify_recordings() {
     let d = tmp();
-    insta::assert_snapshot!(run(
-        &[
-            "identify",
-            "examples/identify/cut_fz0.05.txt",
-            "examples/identify/cut_fz0.08.txt",
-            "--config",
-            "examples/identify/cut.toml",
-            "--json",
-            "-",
-        ],
-        d.path()
-    ));
+    insta::assert_snapshot!(run(&IDENTIFY_EXAMPLE, d.path()));
 }
 
 #[test]
@@ -620,31 +625,8 @@ fn grind_check() {
 /// the last digits of ρ, λ and the coefficients varied from run to run on several threads.
 #[test]
 fn identify_is_identical_at_any_thread_count() {
-    let root = example("..");
-    let report = |threads: &str| {
-        let out = runout()
-            .current_dir(&root)
-            .env("RAYON_NUM_THREADS", threads)
-            .args([
-                "identify",
-                "examples/identify/cut_fz0.05.txt",
-                "examples/identify/cut_fz0.08.txt",
-                "--config",
-                "examples/identify/cut.toml",
-                "--json",
-                "-",
-            ])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        v.as_object_mut().unwrap().remove("provenance");
-        v
-    };
+    let d = tmp();
+    let report = |threads: &str| run_on_threads(&IDENTIFY_EXAMPLE, d.path(), threads);
     let one = report("1");
     for threads in ["2", "3", "2", "3"] {
         assert!(

@@ -517,24 +517,9 @@ impl HarmonicProblem<'_> {
                 })
             })
             .collect();
-        let g = (0..self.data.len())
-            .map(|c| {
-                self.cases[c]
-                    .waveform
-                    .components
-                    .iter()
-                    .map(|comp| {
-                        let mut g = vec![[zero; 6]; used[c].len()];
-                        for (m, &u) in used[c].iter().enumerate() {
-                            if u {
-                                g[m] = gradient_harmonic(&basis[c], comp.axis, m);
-                            }
-                        }
-                        g
-                    })
-                    .collect()
-            })
-            .collect();
+        let g = self.at_used_harmonics(&used, [zero; 6], |c, axis, m| {
+            gradient_harmonic(&basis[c], axis, m)
+        });
         let (y, _) = self.measured_rows();
         let (used, polar) = (Arc::new(used), Arc::new(polar));
         Tables {
@@ -564,6 +549,19 @@ impl HarmonicProblem<'_> {
         polar: &[Option<Vec<Complex64>>],
     ) -> Vec<Vec<Vec<Complex64>>> {
         let modes: Vec<SensorMode> = (0..self.mode_axes.len()).map(|m| self.mode(m)).collect();
+        self.at_used_harmonics(used, Complex64::new(0.0, 0.0), |c, axis, m| {
+            self.factor_with(c, axis, m, polar[c].as_deref(), &modes)
+        })
+    }
+    /// `f(case, axis, m)` for every case, every component of its waveform and every folded
+    /// harmonic m that `used` marks, `zero` at the others: the layout of [`Tables`]' per-harmonic
+    /// tables.
+    fn at_used_harmonics<T: Clone>(
+        &self,
+        used: &[Vec<bool>],
+        zero: T,
+        f: impl Fn(usize, FrameAxis, usize) -> T,
+    ) -> Vec<Vec<Vec<T>>> {
         (0..self.data.len())
             .map(|c| {
                 self.cases[c]
@@ -571,14 +569,13 @@ impl HarmonicProblem<'_> {
                     .components
                     .iter()
                     .map(|comp| {
-                        let mut h = vec![Complex64::new(0.0, 0.0); used[c].len()];
+                        let mut t = vec![zero.clone(); used[c].len()];
                         for (m, &u) in used[c].iter().enumerate() {
                             if u {
-                                h[m] =
-                                    self.factor_with(c, comp.axis, m, polar[c].as_deref(), &modes);
+                                t[m] = f(c, comp.axis, m);
                             }
                         }
-                        h
+                        t
                     })
                     .collect()
             })
