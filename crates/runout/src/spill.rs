@@ -128,8 +128,8 @@ impl SpillReader {
         chunk.values.resize_with(self.channels, Vec::new);
         for c in &mut chunk.values {
             if cfg!(target_endian = "little") {
-                // the file's layout is the values' memory: read straight into them
-                c.clear();
+                // the file's layout is the values' memory: read straight into them (a recycled
+                // buffer of the same length is not cleared first: every value is overwritten)
                 c.resize(n, 0.0);
                 self.r.read_exact(bytemuck::cast_slice_mut(c))?;
             } else {
