@@ -14,8 +14,20 @@ use std::path::Path;
 use std::sync::{Mutex, OnceLock};
 use std::thread::JoinHandle;
 
-static PENDING: Mutex<Option<JoinHandle<Option<Provenance>>>> = Mutex::new(None);
-static DONE: OnceLock<Option<Provenance>> = OnceLock::new();
+static PENDING: Mutex<Option<JoinHandle<std::io::Result<Provenance>>>> = Mutex::new(None);
+static DONE: OnceLock<Outcome> = OnceLock::new();
+
+/// What the hashing thread ended with.
+#[derive(Debug)]
+enum Outcome {
+    /// [`start`] was not called (unit tests): no provenance, nothing to tell.
+    NotStarted,
+    /// Every input hashed.
+    Done(Provenance),
+    /// Why there is no provenance (an input could not be read to hash it, which names the file
+    /// and the error, or the thread panicked).
+    Failed(String),
+}
 
 /// Starts hashing the inputs named on `args` (program name first) and registers the plots'
 /// metadata provider.
@@ -23,7 +35,7 @@ pub fn start(args: Vec<String>) {
     let inputs: Vec<Source> = input_files(&args).into_iter().map(Source::path).collect();
     let handle = std::thread::spawn(move || {
         lowest_priority();
-        Provenance::new(args, &inputs).ok()
+        Provenance::new(args, &inputs)
     });
     *PENDING.lock().unwrap_or_else(|e| e.into_inner()) = Some(handle);
     runout_io::plot::metadata::set_provider(Some(Box::new(|| get().map(Provenance::summary_line))));
@@ -43,34 +55,103 @@ fn lowest_priority() {
 }
 
 /// The provenance of this run (waits for the hashing to finish); `None` if [`start`] was not
-/// called or an input could not be read (the job reports that itself).
+/// called or an input could not be read ([`stamped_json`] tells the user why).
 pub fn get() -> Option<&'static Provenance> {
-    DONE.get_or_init(|| {
-        let handle = PENDING.lock().unwrap_or_else(|e| e.into_inner()).take()?;
-        handle.join().ok().flatten()
-    })
-    .as_ref()
-}
-
-/// The report as `--json` writes it: the job's JSON plus `provenance`.
-pub fn stamped_json<R: Report>(report: &R) -> serde_json::Result<String> {
-    match get() {
-        Some(provenance) => {
-            Ok(serde_json::to_string_pretty(&Stamped { report, provenance })? + "\n")
-        }
-        None => crate::provenance::stamped_json(report),
+    match outcome() {
+        Outcome::Done(p) => Some(p),
+        Outcome::NotStarted | Outcome::Failed(_) => None,
     }
 }
 
-/// The files named on the command line: every argument (or `--flag=value` value) that is an
-/// existing file, or `FILE:SELECTOR` whose `FILE` is one.
-pub fn input_files(args: &[String]) -> Vec<String> {
-    let mut files: Vec<String> = Vec::new();
-    for arg in args.iter().skip(1) {
-        let value = match arg.split_once('=') {
-            Some((flag, v)) if flag.starts_with("--") => v,
-            _ => arg.as_str(),
+/// The hashing thread's result, waited for once; a failure is told on stderr then (once, unless
+/// `--quiet`): the outputs go without provenance. The wait ends when the thread does: it only
+/// reads the input files to their end (regular files: [`input_files`] names no FIFO or device),
+/// and a panic in it is a [`Outcome::Failed`], not a hang.
+fn outcome() -> &'static Outcome {
+    DONE.get_or_init(|| {
+        let Some(handle) = PENDING.lock().unwrap_or_else(|e| e.into_inner()).take() else {
+            return Outcome::NotStarted;
         };
+        let outcome = match handle.join() {
+            Ok(Ok(p)) => Outcome::Done(p),
+            Ok(Err(e)) => Outcome::Failed(e.to_string()),
+            Err(_) => Outcome::Failed("the thread hashing the inputs panicked".to_string()),
+        };
+        if let Some(w) = warning(&outcome) {
+            crate::progress::warn(&w);
+        }
+        outcome
+    })
+}
+
+/// What to tell the user when the outputs go without provenance.
+fn warning(outcome: &Outcome) -> Option<String> {
+    match outcome {
+        Outcome::Failed(why) => Some(format!(
+            "the outputs carry no provenance (command line, inputs' SHA-256): {why}"
+        )),
+        Outcome::NotStarted | Outcome::Done(_) => None,
+    }
+}
+
+/// The report as `--json` writes it: the job's JSON plus `provenance`. Without a provenance
+/// (an input could not be read to hash it: [`outcome`] has told the user) the job's JSON alone.
+pub fn stamped_json<R: Report>(report: &R) -> serde_json::Result<String> {
+    json_with(report, outcome())
+}
+
+/// The JSON of `report`, stamped with the provenance if there is one.
+fn json_with<R: Report>(report: &R, outcome: &Outcome) -> serde_json::Result<String> {
+    match outcome {
+        Outcome::Done(provenance) => {
+            Ok(serde_json::to_string_pretty(&Stamped { report, provenance })? + "\n")
+        }
+        Outcome::NotStarted | Outcome::Failed(_) => runout::to_json(report),
+    }
+}
+
+/// Long names of the options whose value is a path the command WRITES (a file or a folder):
+/// never an input, even when it exists already (its old content is not what the report comes
+/// from; hashing it would also read a file the user may have made write-only). `--recording` is
+/// `simulate`'s DynoWare output (recordings read by other commands are positional). `--summary`
+/// (`batch`) is read first to resume, but it is the table the command writes.
+pub const OUTPUT_FLAGS: &[&str] = &[
+    "json",
+    "out",
+    "text",
+    "html",
+    "plot",
+    "plot-dir",
+    "map",
+    "path-out",
+    "recording",
+    "summary",
+    "parquet",
+    "dir",
+];
+
+/// Long names of the options whose value is a path the command reads. Not used to choose the
+/// inputs (every value not in [`OUTPUT_FLAGS`] that names an existing file is one); listed so
+/// that every path option is classified, which a test checks on the whole command tree.
+#[cfg(test)]
+const INPUT_FLAGS: &[&str] = &["config", "sensor-frf", "probe", "generatrix", "nc"];
+
+/// The input files named on the command line `args` (program name first; the command line of
+/// this program, parsed again): the value of every argument, positional or option, other than
+/// the options in [`OUTPUT_FLAGS`], that is an existing regular file, or `FILE:SELECTOR` whose
+/// `FILE` is one. In command-line order, each once.
+pub fn input_files(args: &[String]) -> Vec<String> {
+    use clap::CommandFactory;
+    let cmd = crate::Cli::command();
+    // the command line was parsed by `main` before: this cannot fail
+    let Ok(matches) = cmd.clone().try_get_matches_from(args) else {
+        return Vec::new();
+    };
+    let mut values: Vec<(usize, &str)> = Vec::new();
+    collect_values(&cmd, &matches, &mut values);
+    values.sort_by_key(|&(index, _)| index);
+    let mut files: Vec<String> = Vec::new();
+    for (_, value) in values {
         let candidate = if Path::new(value).is_file() {
             Some(value)
         } else {
@@ -88,9 +169,41 @@ pub fn input_files(args: &[String]) -> Vec<String> {
     files
 }
 
+/// The values given on the command line to the arguments of `cmd` (and of the subcommand
+/// chosen), except those of [`OUTPUT_FLAGS`], with their positions on the command line.
+fn collect_values<'m>(
+    cmd: &clap::Command,
+    matches: &'m clap::ArgMatches,
+    values: &mut Vec<(usize, &'m str)>,
+) {
+    for arg in cmd.get_arguments() {
+        let id = arg.get_id().as_str();
+        let output =
+            !arg.is_positional() && arg.get_long().is_some_and(|l| OUTPUT_FLAGS.contains(&l));
+        let given = matches.value_source(id) == Some(clap::parser::ValueSource::CommandLine);
+        if output || !given || !arg.get_action().takes_values() {
+            continue;
+        }
+        let (Ok(Some(raw)), Some(indices)) = (matches.try_get_raw(id), matches.indices_of(id))
+        else {
+            continue;
+        };
+        values.extend(indices.zip(raw).filter_map(|(i, v)| Some((i, v.to_str()?))));
+    }
+    if let Some((name, sub_matches)) = matches.subcommand() {
+        if let Some(sub) = cmd.find_subcommand(name) {
+            collect_values(sub, sub_matches, values);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn strings(args: &[&str]) -> Vec<String> {
+        args.iter().map(|a| a.to_string()).collect()
+    }
 
     #[test]
     fn input_files_are_the_existing_files_named() {
@@ -112,5 +225,162 @@ mod tests {
             "3000".into(),
         ];
         assert_eq!(input_files(&args), vec![s(&a), s(&m)]);
+    }
+
+    /// The old content of an output is not an input, however the flag is written (`--json F`,
+    /// `--html=F`, a hidden alias); inputs come in command-line order.
+    #[test]
+    fn existing_outputs_are_not_inputs() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = |name: &str| {
+            let p = dir.path().join(name);
+            std::fs::write(&p, "x").unwrap();
+            p.display().to_string()
+        };
+        let (cfg, rec, frf) = (file("cut.toml"), file("rec.txt"), file("frf.csv"));
+        let (json, html, plot) = (file("out.json"), file("out.html"), file("old.svg"));
+        let plots = dir.path().join("plots");
+        std::fs::create_dir(&plots).unwrap();
+        let args = strings(&[
+            "runout",
+            "identify",
+            "--config",
+            &cfg,
+            "--json",
+            &json,
+            &rec,
+            &format!("--html={html}"),
+            "--sensor-frf",
+            &frf,
+            "--plot-dir",
+            &plots.display().to_string(),
+        ]);
+        assert_eq!(input_files(&args), vec![cfg.clone(), rec.clone(), frf]);
+        let (csv, dwd) = (file("old.csv"), file("old.txt"));
+        let args = strings(&[
+            "runout",
+            "simulate",
+            "--quiet",
+            "--config",
+            &cfg,
+            "--out",
+            &csv,
+            "--recording",
+            &dwd,
+            "--json",
+            &json,
+            "--plot",
+            &plot,
+        ]);
+        assert_eq!(input_files(&args), vec![cfg.clone()]);
+        let (nc, probe, out_nc, path_csv) = (
+            file("in.nc"),
+            file("probe.csv"),
+            file("out.nc"),
+            file("path.csv"),
+        );
+        let args = strings(&[
+            "runout",
+            "grind",
+            "compensate",
+            "--out",
+            &out_nc,
+            "--nc",
+            &nc,
+            "--probe",
+            &probe,
+            "--path-out",
+            &path_csv,
+        ]);
+        assert_eq!(input_files(&args), vec![nc, probe]);
+    }
+
+    /// Every option whose value is a path is classified as written ([`OUTPUT_FLAGS`]) or read
+    /// ([`INPUT_FLAGS`]), on every subcommand: a new output flag missing from [`OUTPUT_FLAGS`]
+    /// fails here instead of having its old file hashed as an input. Every name listed is an
+    /// option of some command (no stale entry), and in one list only.
+    #[test]
+    fn every_path_option_is_classified() {
+        use clap::CommandFactory;
+        fn walk(
+            cmd: &clap::Command,
+            path: &str,
+            found: &mut Vec<String>,
+            errors: &mut Vec<String>,
+        ) {
+            for arg in cmd.get_arguments() {
+                let Some(long) = arg.get_long() else { continue };
+                found.push(long.to_string());
+                let is_path = arg.get_value_parser().type_id()
+                    == clap::builder::ValueParser::path_buf().type_id();
+                if is_path && !OUTPUT_FLAGS.contains(&long) && !INPUT_FLAGS.contains(&long) {
+                    errors.push(format!("{path} --{long}"));
+                }
+            }
+            for sub in cmd.get_subcommands() {
+                walk(sub, &format!("{path} {}", sub.get_name()), found, errors);
+            }
+        }
+        let (mut found, mut errors) = (Vec::new(), Vec::new());
+        walk(&crate::Cli::command(), "runout", &mut found, &mut errors);
+        assert!(
+            errors.is_empty(),
+            "path options neither in OUTPUT_FLAGS nor in INPUT_FLAGS (provenance.rs): {errors:?}"
+        );
+        for name in OUTPUT_FLAGS.iter().chain(INPUT_FLAGS) {
+            assert!(found.iter().any(|f| f == name), "--{name} is no option");
+        }
+        assert!(OUTPUT_FLAGS.iter().all(|o| !INPUT_FLAGS.contains(o)));
+    }
+
+    fn report() -> runout::batch::BatchReport {
+        runout::batch::BatchReport {
+            schema: "runout.batch/1".into(),
+            summary: "s.csv".into(),
+            files: 1,
+            skipped: 0,
+            analysed: 1,
+            ok: 1,
+            failed: Vec::new(),
+            rows: 1,
+            threads: 1,
+            elapsed_s: 0.5,
+            recordings_per_s: 2.0,
+        }
+    }
+
+    /// A failed hashing gives the report without provenance and a warning naming the file and
+    /// the error (it once called `stamped_json` again, forever).
+    #[test]
+    fn without_provenance_the_report_is_written_alone_and_the_user_told() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing = Source::path(dir.path().join("gone.txt"));
+        let e = Provenance::new(["runout"], &[missing]).unwrap_err();
+        let failed = Outcome::Failed(e.to_string());
+        let json = json_with(&report(), &failed).unwrap();
+        assert_eq!(json, runout::to_json(&report()).unwrap());
+        assert!(!json.contains("provenance"), "{json}");
+        let w = warning(&failed).unwrap();
+        assert!(
+            w.contains("no provenance") && w.contains("gone.txt") && w.contains("cannot read"),
+            "{w}"
+        );
+        let done = Outcome::Done(Provenance::new(["runout", "x"], &[]).unwrap());
+        let v: serde_json::Value =
+            serde_json::from_str(&json_with(&report(), &done).unwrap()).unwrap();
+        assert_eq!(v["provenance"]["command_line"][1], "x");
+        assert_eq!(warning(&done), None);
+    }
+
+    /// `stamped_json` without provenance (here: never started) returns, within a bound (a
+    /// recursion would spin here for ever; the bound turns it into a failure).
+    #[test]
+    fn stamped_json_without_provenance_returns() {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || tx.send(stamped_json(&report()).unwrap()));
+        let json = rx
+            .recv_timeout(std::time::Duration::from_secs(60))
+            .expect("stamped_json did not return within 60 s");
+        assert_eq!(json, runout::to_json(&report()).unwrap());
     }
 }

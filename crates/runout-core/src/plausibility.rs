@@ -58,6 +58,14 @@ impl std::fmt::Display for Finding {
     }
 }
 
+/// Largest force magnitude (N) a force recording may hold: above it a sample is no measured
+/// force but a corrupt cell (a digit run together, an exponent, a sentinel such as `1e308`).
+/// Milling dynamometers measure up to tens of kN (Kistler 9255C: ±30 kN in x/y, −10…60 kN in z)
+/// and an end mill breaks under a few kN; the largest industrial load cells reach tens of MN. A
+/// bound of 1e9 N is far above all of them (no real recording is refused), and far below the
+/// magnitudes whose spectra overflow (a sample above ≈ 1e154 N has an infinite square).
+pub const MAX_PLAUSIBLE_FORCE_N: f64 = 1e9;
+
 /// Largest plausible runout as a fraction of the cutter radius.
 pub const MAX_RUNOUT_FRACTION_OF_RADIUS: f64 = 0.05;
 /// Largest plausible runout (mm).
@@ -265,6 +273,23 @@ impl ClipDetector {
             } else {
                 block.iter().for_each(|&v| self.push_one(v));
             }
+        }
+    }
+
+    /// The largest magnitude among the finite samples fed so far (0 before any).
+    ///
+    /// ```
+    /// use runout_core::plausibility::ClipDetector;
+    /// let mut d = ClipDetector::new();
+    /// assert_eq!(d.max_abs(), 0.0);
+    /// d.push(&[1.0, -7.5, f64::NAN, 3.0]);
+    /// assert_eq!(d.max_abs(), 7.5);
+    /// ```
+    pub fn max_abs(&self) -> f64 {
+        if self.samples == 0 {
+            0.0
+        } else {
+            self.max.value.abs().max(self.min.value.abs())
         }
     }
 

@@ -28,6 +28,7 @@ mod identify_recording;
 mod install;
 mod issue20;
 mod progress_tty;
+mod provenance;
 mod readme_commands;
 mod shank;
 mod simulate;

@@ -458,7 +458,10 @@ impl<R: BufRead> RecordingReader<R> {
                 .collect(),
             None => Vec::new(),
         };
-        let meta_rate = header.sampling_rate(decimal_comma);
+        let (meta_rate, bad_meta_rate) = match header.sampling_rate(decimal_comma) {
+            Ok(rate) => (rate, None),
+            Err(bad) => (None, Some(bad)),
+        };
         // rate over the strictly increasing prefix (a later defect is reported at its line)
         let increasing = 1 + times.windows(2).take_while(|w| w[1] > w[0]).count();
         let times = &times[..increasing.min(times.len())];
@@ -481,13 +484,27 @@ impl<R: BufRead> RecordingReader<R> {
         } else if let Some(t) = time_rate {
             (t, "estimated from the time column's first rows".to_string())
         } else {
-            let extra = if time.is_some() {
+            let mut extra = if time.is_some() {
                 " with at least two valid rows".to_string()
             } else {
                 String::new()
             };
+            if let Some(bad) = &bad_meta_rate {
+                extra.push_str(&format!(
+                    " and the header's {} is not a sample rate",
+                    bad.describe()
+                ));
+            }
             return Err(RecordingError::NoSampleRate { file, extra });
         };
+        if let (Some(bad), false) = (&bad_meta_rate, table) {
+            warnings.push(format!(
+                "{file}:{}: the header's {} is not a sample rate (a positive, finite number of Hz \
+                 expected): ignored, using {rate} Hz {source}",
+                bad.line,
+                bad.describe()
+            ));
+        }
         let start = options.start_time_s.unwrap_or(0.0);
         let info = RecordingInfo {
             file: file.clone(),
@@ -984,10 +1001,27 @@ struct HeaderParts {
     format: Format,
     delimiter: u8,
     metadata: Vec<(String, String)>,
+    /// The line of each `metadata` entry.
+    metadata_lines: Vec<u64>,
     names: Vec<String>,
     units: Option<Vec<String>>,
     names_line: u64,
     last_line: u64,
+}
+
+/// A DynoWare `Sampling rate` line whose value is no sample rate (0, negative, not finite, not a
+/// number): ignored, with a warning naming it.
+struct BadRate {
+    line: u64,
+    key: String,
+    value: String,
+}
+
+impl BadRate {
+    /// `` `Sampling rate [Hz]: 0` ``: the line's key and value, as messages quote it.
+    fn describe(&self) -> String {
+        format!("`{}: {}`", self.key, self.value)
+    }
 }
 
 impl HeaderParts {
@@ -1039,16 +1073,30 @@ impl HeaderParts {
             .map(|(k, v)| (k.as_str(), v.as_str()))
     }
 
-    /// `Sampling rate [Hz]` (or `[kHz]`) from DynoWare metadata.
-    fn sampling_rate(&self, decimal_comma: bool) -> Option<f64> {
-        let (k, v) = self.meta("sampling rate")?;
-        let f = meta_number(v, decimal_comma)?;
+    /// `Sampling rate [Hz]` (or `[kHz]`) from DynoWare metadata, in Hz: `Ok(None)` without such
+    /// a line, [`BadRate`] when its value is not a positive, finite number.
+    fn sampling_rate(&self, decimal_comma: bool) -> std::result::Result<Option<f64>, BadRate> {
+        let Some(i) = self
+            .metadata
+            .iter()
+            .position(|(k, _)| k.to_ascii_lowercase().starts_with("sampling rate"))
+        else {
+            return Ok(None);
+        };
+        let (k, v) = &self.metadata[i];
         let scale = if k.to_ascii_lowercase().contains("khz") {
             1e3
         } else {
             1.0
         };
-        Some(f * scale).filter(|f| *f > 0.0)
+        match meta_number(v, decimal_comma).map(|f| f * scale) {
+            Some(f) if f.is_finite() && f > 0.0 => Ok(Some(f)),
+            _ => Err(BadRate {
+                line: self.metadata_lines.get(i).copied().unwrap_or(0),
+                key: k.clone(),
+                value: v.clone(),
+            }),
+        }
     }
 
     fn expected_samples(&self) -> Option<u64> {
@@ -1086,6 +1134,7 @@ fn read_dynoware_header<R: BufRead>(
         .trim()
         .to_string();
     let mut metadata = Vec::new();
+    let mut metadata_lines = Vec::new();
     let (names_line, names) = loop {
         let Some(n) = lines.next_nonblank(buf)? else {
             return Err(header_err(
@@ -1104,7 +1153,10 @@ fn read_dynoware_header<R: BufRead>(
         }
         let s = decode(buf);
         match key_line(&s, delimiter as char) {
-            Some(kv) => metadata.push(kv),
+            Some(kv) => {
+                metadata.push(kv);
+                metadata_lines.push(n);
+            }
             None => break (n, split_cells(&s, delimiter)),
         }
     };
@@ -1127,6 +1179,7 @@ fn read_dynoware_header<R: BufRead>(
         format: Format::DynoWare { version },
         delimiter,
         metadata,
+        metadata_lines,
         names,
         last_line: if units.is_some() {
             units_line
@@ -1173,6 +1226,7 @@ fn read_generic_header<R: BufRead>(
         format: Format::GenericCsv,
         delimiter,
         metadata: Vec::new(),
+        metadata_lines: Vec::new(),
         names,
         units,
         names_line: first_no,
@@ -1191,6 +1245,64 @@ fn split_cells(s: &str, delimiter: u8) -> Vec<String> {
 mod tests {
     use super::*;
     use std::io::Cursor;
+
+    /// A DynoWare `Sampling rate` that is no sample rate (0, negative, not finite, not a number)
+    /// is ignored for the time column's step, as before, but no longer silently: a warning names
+    /// the file, the line, the value, and the rate used instead (where it comes from).
+    #[test]
+    fn dynoware_rate_that_is_no_rate_is_a_warning_naming_the_line() {
+        let text = |rate: &str| {
+            format!(
+                "DynoWare,Version 2.5.1.2\nFilename:,x.dwd\nSampling rate [Hz]:,{rate}\n\
+                 Time,Fx,Fy\ns,N,N\n0,1,2\n0.5,3,4\n1,5,6\n1.5,7,8\n"
+            )
+        };
+        for rate in ["0", "-10000", "inf", "NaN", "ten", ""] {
+            let t = text(rate);
+            let r = RecordingReader::from_bytes("x.txt", t.as_bytes(), &ReadOptions::new())
+                .unwrap_or_else(|e| panic!("{rate}: {e}"));
+            // the time column's step (0.5 s), exactly: 3 steps / 1.5 s
+            assert_eq!(r.info().sample_rate_hz, 2.0, "{rate}");
+            assert_eq!(
+                r.warnings(),
+                [format!(
+                    "x.txt:3: the header's `Sampling rate [Hz]: {rate}` is not a sample rate (a \
+                     positive, finite number of Hz expected): ignored, using 2 Hz estimated from \
+                     the time column's first rows"
+                )],
+                "{rate}"
+            );
+            // a rate given by the caller is the one used, and the message says so
+            let opts = ReadOptions::new().sample_rate_hz(2.0);
+            let r = RecordingReader::from_bytes("x.txt", t.as_bytes(), &opts).unwrap();
+            assert!(
+                r.warnings()[0].ends_with("ignored, using 2 Hz given by the caller"),
+                "{:?}",
+                r.warnings()
+            );
+        }
+        // a good rate: used, no warning (the time column agrees with it)
+        let t = text("2");
+        let r = RecordingReader::from_bytes("x.txt", t.as_bytes(), &ReadOptions::new()).unwrap();
+        assert_eq!(r.info().sample_rate_hz, 2.0);
+        assert!(r.warnings().is_empty(), "{:?}", r.warnings());
+        // [kHz] scales; 1e306 kHz overflows to infinity: no rate either
+        let t = text("1e306").replace("[Hz]", "[kHz]");
+        let r = RecordingReader::from_bytes("x.txt", t.as_bytes(), &ReadOptions::new()).unwrap();
+        assert!(r.warnings()[0].starts_with("x.txt:3: the header's `Sampling rate [kHz]: 1e306`"));
+        // without a time column, the error says why the header's rate was not taken
+        let t = "DynoWare,Version 2.5\nSampling rate [Hz]:,0\nFx,Fy\nN,N\n1,2\n3,4\n";
+        let e = RecordingReader::from_bytes("x.txt", t.as_bytes(), &ReadOptions::new())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            e.contains(
+                "no time column and the header's `Sampling rate [Hz]: 0` is not a sample rate"
+            ),
+            "{e}"
+        );
+    }
 
     /// A source that gives at most 7 bytes per read, so that lines are cut anywhere between
     /// reads of the input block.

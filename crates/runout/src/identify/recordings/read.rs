@@ -6,11 +6,11 @@ use super::{FileResult, RecordingsRequest};
 use crate::job::{Progress, Source};
 use crate::spill::Spill;
 use anyhow::{bail, Context, Result};
-use runout_core::plausibility::{ClipDetector, Finding};
+use runout_core::plausibility::{ClipDetector, Finding, MAX_PLAUSIBLE_FORCE_N};
 use runout_core::signal::{self, ForceComponent, PulseConfig, SignalConfig};
 use runout_core::Cut;
 use runout_io::recording::{
-    AxisMapping, FrameAxis, ReadOptions, RecordingChunk, RecordingInfo, RecordingReader,
+    AxisMapping, Format, FrameAxis, ReadOptions, RecordingChunk, RecordingInfo, RecordingReader,
     ResolvedAxes,
 };
 use runout_io::units::Quantity;
@@ -52,6 +52,10 @@ struct Channels {
     axes: ResolvedAxes,
     factors: Vec<f64>,
     pulse: Option<usize>,
+    /// The recording's name and, per workpiece axis, the index of its source channel and how
+    /// messages name it (for [`implausible_force`]).
+    file: String,
+    sources: [Option<(usize, String)>; 3],
 }
 
 fn channels(name: &str, info: &RecordingInfo, req: &RecordingsRequest) -> Result<Channels> {
@@ -88,12 +92,52 @@ fn channels(name: &str, info: &RecordingInfo, req: &RecordingsRequest) -> Result
         })?),
         None => None,
     };
+    let text = matches!(info.format, Format::GenericCsv | Format::DynoWare { .. });
+    let sources = FrameAxis::ALL.map(|ax| {
+        let s = mapping.source(ax)?;
+        let i = info.channel_index(&s.channel)?;
+        let c = &info.channels[i];
+        let unit = c.unit.as_deref().unwrap_or("N");
+        Some(match text {
+            true => (
+                i,
+                format!("channel `{}` ({unit}, column {})", c.header, c.column),
+            ),
+            false => (i, format!("channel `{}` ({unit})", c.header)),
+        })
+    });
     Ok(Channels {
         mapping,
         axes,
         factors,
         pulse,
+        file: name.to_string(),
+        sources,
     })
+}
+
+/// The error for a chunk whose workpiece axis `k` (forces `v`, N) holds a sample beyond
+/// [`MAX_PLAUSIBLE_FORCE_N`]: the first such sample by its number and time, and the cell of its
+/// source channel as the file has it.
+fn implausible_force(ch: &Channels, chunk: &RecordingChunk, k: usize, v: &[f64]) -> anyhow::Error {
+    let i = v
+        .iter()
+        .position(|x| x.abs() > MAX_PLAUSIBLE_FORCE_N)
+        .unwrap_or(0);
+    let axis = ["x", "y", "z"][k];
+    let source = match &ch.sources[k] {
+        Some((c, name)) => format!("{name} reads {:e}", chunk.channel(*c)[i]),
+        None => format!("workpiece {axis} is {:e} N", v[i]),
+    };
+    anyhow::anyhow!(
+        "{}: sample {} (counted from 1; t = {} s): {source}, a force of {:e} N on workpiece {axis} — not a \
+         measured force (more than {MAX_PLAUSIBLE_FORCE_N:e} N, beyond any dynamometer's range); \
+         check that cell",
+        ch.file,
+        chunk.first_sample + i as u64 + 1,
+        chunk.time_s[i],
+        v[i].abs()
+    )
 }
 
 fn signal_config(
@@ -283,6 +327,10 @@ fn map_chunk(
         {
             watch.clip[k].push(v);
             watch.hash.write(bytemuck::cast_slice(v));
+            // the detector's extremes: nothing to scan while the forces are plausible
+            if watch.clip[k].max_abs() > MAX_PLAUSIBLE_FORCE_N {
+                return Err(implausible_force(ch, chunk, k, v));
+            }
         }
         if let Some(i) = ch.pulse {
             out.values.push(chunk.channel(i).to_vec());
