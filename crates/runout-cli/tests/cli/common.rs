@@ -18,6 +18,16 @@ pub fn example(path: &str) -> PathBuf {
         .join(path)
 }
 
+/// `runout identify` on the bundled example (the README's main job) without its outputs: run
+/// from the repository root, followed by the output flags a test wants.
+pub const IDENTIFY_EXAMPLE_INPUTS: [&str; 5] = [
+    "identify",
+    "examples/identify/cut_fz0.05.txt",
+    "examples/identify/cut_fz0.08.txt",
+    "--config",
+    "examples/identify/cut.toml",
+];
+
 /// Seed 003's cut as `runout simulate` flags: K 4, D 10 mm, 3240 rpm, f_z 0.08 mm, a_p 1 mm,
 /// a_e 2 mm down-milling.
 pub const SEED003_CUT: [&str; 15] = [

@@ -7,7 +7,7 @@
 //! error, the verdict and plots in the DOM, a screenshot) is the ignored test at the end.
 
 use crate::common;
-use common::{example, runout, Ran};
+use common::{example, runout, Ran, IDENTIFY_EXAMPLE_INPUTS};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -131,17 +131,9 @@ fn read_json(p: &Path) -> Value {
 /// The bundled example (the README's main job) with `--html`.
 fn identify_example(dir: &Path) -> (PathBuf, PathBuf) {
     let (h, j) = (dir.join("identify.html"), dir.join("identify.json"));
-    run(&[
-        "identify",
-        "examples/identify/cut_fz0.05.txt",
-        "examples/identify/cut_fz0.08.txt",
-        "--config",
-        "examples/identify/cut.toml",
-        "--json",
-        j.to_str().unwrap(),
-        "--html",
-        h.to_str().unwrap(),
-    ]);
+    let mut args = IDENTIFY_EXAMPLE_INPUTS.to_vec();
+    args.extend(["--json", j.to_str().unwrap(), "--html", h.to_str().unwrap()]);
+    run(&args);
     (h, j)
 }
 

@@ -104,20 +104,14 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 /// `runout identify` on the bundled example, JSON to stdout.
-const IDENTIFY_EXAMPLE: [&str; 7] = [
-    "identify",
-    "examples/identify/cut_fz0.05.txt",
-    "examples/identify/cut_fz0.08.txt",
-    "--config",
-    "examples/identify/cut.toml",
-    "--json",
-    "-",
-];
+fn identify_example() -> Vec<&'static str> {
+    [&IDENTIFY_EXAMPLE_INPUTS[..], &["--json", "-"]].concat()
+}
 
 #[test]
 fn identify_recordings() {
     let d = tmp();
-    insta::assert_snapshot!(run(&IDENTIFY_EXAMPLE, d.path()));
+    insta::assert_snapshot!(run(&identify_example(), d.path()));
 }
 
 #[test]
@@ -626,7 +620,7 @@ fn grind_check() {
 #[test]
 fn identify_is_identical_at_any_thread_count() {
     let d = tmp();
-    let report = |threads: &str| run_on_threads(&IDENTIFY_EXAMPLE, d.path(), threads);
+    let report = |threads: &str| run_on_threads(&identify_example(), d.path(), threads);
     let one = report("1");
     for threads in ["2", "3", "2", "3"] {
         assert!(

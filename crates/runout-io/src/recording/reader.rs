@@ -1066,21 +1066,22 @@ impl HeaderParts {
             .collect()
     }
 
-    fn meta(&self, prefix: &str) -> Option<(&str, &str)> {
+    /// Index of the first metadata entry whose key starts with `prefix` (lower case).
+    fn meta_index(&self, prefix: &str) -> Option<usize> {
         self.metadata
             .iter()
-            .find(|(k, _)| k.to_ascii_lowercase().starts_with(prefix))
-            .map(|(k, v)| (k.as_str(), v.as_str()))
+            .position(|(k, _)| k.to_ascii_lowercase().starts_with(prefix))
+    }
+
+    fn meta(&self, prefix: &str) -> Option<(&str, &str)> {
+        let (k, v) = &self.metadata[self.meta_index(prefix)?];
+        Some((k.as_str(), v.as_str()))
     }
 
     /// `Sampling rate [Hz]` (or `[kHz]`) from DynoWare metadata, in Hz: `Ok(None)` without such
     /// a line, [`BadRate`] when its value is not a positive, finite number.
     fn sampling_rate(&self, decimal_comma: bool) -> std::result::Result<Option<f64>, BadRate> {
-        let Some(i) = self
-            .metadata
-            .iter()
-            .position(|(k, _)| k.to_ascii_lowercase().starts_with("sampling rate"))
-        else {
+        let Some(i) = self.meta_index("sampling rate") else {
             return Ok(None);
         };
         let (k, v) = &self.metadata[i];

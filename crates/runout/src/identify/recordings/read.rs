@@ -98,13 +98,13 @@ fn channels(name: &str, info: &RecordingInfo, req: &RecordingsRequest) -> Result
         let i = info.channel_index(&s.channel)?;
         let c = &info.channels[i];
         let unit = c.unit.as_deref().unwrap_or("N");
-        Some(match text {
-            true => (
-                i,
-                format!("channel `{}` ({unit}, column {})", c.header, c.column),
-            ),
-            false => (i, format!("channel `{}` ({unit})", c.header)),
-        })
+        // a text file's cell is found by its column; a binary format's channel by its name
+        let column = if text {
+            format!(", column {}", c.column)
+        } else {
+            String::new()
+        };
+        Some((i, format!("channel `{}` ({unit}{column})", c.header)))
     });
     Ok(Channels {
         mapping,
