@@ -171,10 +171,27 @@ impl SignalConfig {
             .into());
         }
         if self.samples_per_rev() > 1e7 {
+            // either may be wrong (a header's sampling rate of 1e308 Hz, a speed of 0.001 rpm):
+            // the message names both
             return Err(ParamError::new(
-                "nominal_rpm",
-                "a speed giving at most 10^7 samples per revolution",
-                self.nominal_rpm,
+                "sample_rate_hz, nominal_rpm",
+                "a sample rate and speed giving at most 10^7 samples per revolution",
+                {
+                    // plain digits in the usual ranges, the exponent form outside them
+                    let g = |v: f64| {
+                        if (1e-4..1e9).contains(&v.abs()) {
+                            format!("{v}")
+                        } else {
+                            format!("{v:e}")
+                        }
+                    };
+                    format!(
+                        "{} Hz at {} rpm = {:.3e} samples per revolution",
+                        g(self.sample_rate_hz),
+                        g(self.nominal_rpm),
+                        self.samples_per_rev()
+                    )
+                },
             )
             .into());
         }
@@ -250,5 +267,22 @@ impl SignalConfig {
     /// True when tooth periods are absolute (pulse with tooth-0 angle, and the entry angle).
     pub fn absolute_teeth(&self) -> bool {
         self.entry_angle_rad.is_some() && self.pulse.is_some_and(|p| p.tooth0_angle_rad.is_some())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Too many samples per revolution: the message names the sample rate and the speed (the
+    /// rate of a header such as `Sampling rate [Hz]: 1e308` used to be blamed on the speed).
+    #[test]
+    fn too_many_samples_per_revolution_names_rate_and_speed() {
+        let e = SignalConfig::new(1e308, 4, 3240.0).unwrap_err().to_string();
+        assert!(e.contains("sample_rate_hz, nominal_rpm"), "{e}");
+        assert!(e.contains("1e308 Hz at 3240 rpm"), "{e}");
+        assert!(SignalConfig::new(1e4, 4, 3240.0).is_ok());
+        let e = SignalConfig::new(1e4, 4, 1e-5).unwrap_err().to_string();
+        assert!(e.contains("10000 Hz at 1e-5 rpm = 6.000e10"), "{e}");
     }
 }
