@@ -83,6 +83,27 @@ pub(crate) fn parse_leading_number(
     leading_number_from(rest, delim, decimal_comma, m)
 }
 
+/// A common number cell (sign, digits, fraction: no exponent, no blanks) at the start of
+/// `rest`, ended by `delim`, a line feed or a carriage return: its value, its length and the byte
+/// that ended it. `None` for anything else, and when nothing follows the cell in `rest`. For a
+/// cell it accepts, the value is that of [`parse_leading_number`] on the cell (the same digit
+/// scan and fast path), used where a row's cells are parsed without first finding the row's end
+/// (issue 18).
+#[inline(always)]
+pub(crate) fn parse_common_cell(
+    rest: &[u8],
+    delim: u8,
+    decimal_comma: bool,
+) -> Option<(f64, usize, u8)> {
+    let m = scan_mantissa(rest, decimal_comma);
+    let stop = m.end;
+    let end = *rest.get(stop)?;
+    if end == delim || end == b'\n' || end == b'\r' {
+        return m.fast_value().map(|v| (v, stop, end));
+    }
+    None
+}
+
 /// [`parse_leading_number`] for a cell whose digits did not reach the delimiter (an exponent):
 /// its end is searched from where the scan stopped, and the cell parsed on from there when it
 /// is already trimmed (it starts with a digit, a sign or a point, so only its end can hold
@@ -486,6 +507,26 @@ mod tests {
             leading_agrees_with_split(&row, b',', false)?;
             leading_agrees_with_split(&row, b';', true)?;
             leading_agrees_with_split(&row, b'\t', true)?;
+        }
+
+        /// A common cell ended by the delimiter or a line end: wherever it answers, the byte
+        /// that ended it is the one after the cell, and the value is `parse_number`'s of the
+        /// cell, bit for bit; force-like cells are always taken (issue 18).
+        #[test]
+        fn common_cell_equals_parse_number(row in "[-+0-9.,;eE \t\"x\r\n]{0,24}", v in -1e5f64..1e5, d in 0usize..9, end in "[,;\r\n]") {
+            for (delim, dc) in [(b',', false), (b';', true), (b'\t', true)] {
+                let b = row.as_bytes();
+                if let Some((x, len, e)) = parse_common_cell(b, delim, dc) {
+                    proptest::prop_assert_eq!(b[len], e);
+                    proptest::prop_assert!(e == delim || e == b'\n' || e == b'\r');
+                    proptest::prop_assert_eq!(parse_number(&b[..len], dc).map(f64::to_bits), Some(x.to_bits()), "{:?}", row);
+                }
+            }
+            let cell = format!("{v:.d$}{end}");
+            let delim = if end == ";" { b';' } else { b',' };
+            let got = parse_common_cell(cell.as_bytes(), delim, false);
+            let want = cell[..cell.len() - 1].parse::<f64>().unwrap();
+            proptest::prop_assert_eq!(got.map(|(x, len, _)| (x.to_bits(), len)), Some((want.to_bits(), cell.len() - 1)), "{:?}", cell);
         }
 
         /// Force-like cells followed by a delimiter and more cells: always taken, same bits.

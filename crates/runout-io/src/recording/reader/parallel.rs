@@ -6,7 +6,9 @@
 //! [`RecordingReader::read_chunk`] called in a loop.
 //!
 //! Memory is bounded by the jobs in flight: per worker one job queued, one being parsed and one
-//! result queued (≈ 3 × 1 MiB of text and its columns), whatever the file's length.
+//! result queued, plus the result being taken (≈ 4 × 1 MiB of text and its columns: a result
+//! keeps its text until its rows are taken, so that an error's position in bytes can be found in
+//! it), whatever the file's length.
 
 use super::{
     checked_time, long_line, trim_field, RecordingChunk, RecordingError, RecordingReader, Result,
@@ -14,6 +16,9 @@ use super::{
 };
 use std::io::{BufRead, Read};
 use std::sync::mpsc;
+
+/// Lines of a job that may fail the common-row path before the job may stop trying it.
+const COMMON_MISSES: u64 = 16;
 
 /// Bytes of input per job (cut at the next line end).
 const JOB_BYTES: usize = 1 << 20;
@@ -44,6 +49,12 @@ struct Parsed {
     bytes: u64,
     /// The error at the job's last line (numbered from 1 at the job's first line).
     error: Option<RecordingError>,
+    /// Bytes of the job up to the error: through the failing line, as the serial reader has
+    /// consumed it when it reports the error.
+    error_bytes: u64,
+    /// The job's text, kept until the rows are taken (a time error's position in bytes is
+    /// found in it), then handed back to the splitter.
+    text: Vec<u8>,
 }
 
 impl Parsed {
@@ -56,6 +67,17 @@ impl Parsed {
         self.lines = 0;
         self.bytes = 0;
         self.error = None;
+        self.error_bytes = 0;
+    }
+
+    /// Bytes of the job's text through its first `lines` lines, endings included.
+    fn bytes_through(&self, lines: u64) -> u64 {
+        if lines == 0 {
+            return 0;
+        }
+        memchr::memchr_iter(b'\n', &self.text)
+            .nth(lines as usize - 1)
+            .map_or(self.text.len(), |k| k + 1) as u64
     }
 
     /// The 0-based line in the job of row `row`.
@@ -73,13 +95,37 @@ impl Parsed {
 }
 
 /// Parse the lines of a job as `Block::next_line` + `RecordingReader::parse_row` would (line
-/// length limit, `\r\n` endings, blank lines skipped), the time cells unchecked.
+/// length limit, `\r\n` endings, blank lines skipped), the time cells unchecked. A common row
+/// (plain numbers, nothing else) is parsed as it is scanned, without a search for its end first
+/// (`RowParser::parse_common_line`); any other line, or a common row's line when such rows are
+/// rare in the job, takes the full path.
 fn parse_job(p: &RowParser<'_>, has_time: bool, bytes: &[u8], out: &mut Parsed) {
     out.bytes = bytes.len() as u64;
     let mut pos = 0;
     let mut line = 0u64;
+    let mut common = p.common_lines();
+    let mut misses = 0u64;
     while pos < bytes.len() {
         let rest = &bytes[pos..];
+        if common {
+            let mut time = None;
+            if let Some(consumed) = p.parse_common_line(rest, &mut out.values, &mut time) {
+                if has_time {
+                    out.times.push(time.unwrap_or(f64::NAN));
+                }
+                out.rows += 1;
+                line += 1;
+                pos += consumed;
+                continue;
+            }
+            for v in &mut out.values {
+                v.truncate(out.rows);
+            }
+            // lines of another form (exponents, blanks, quotes) go the full way; when they are
+            // more than one in eight, the job stops trying the common path first
+            misses += 1;
+            common = misses < COMMON_MISSES || misses * 8 < line;
+        }
         let (mut len, consumed) = match memchr::memchr(b'\n', rest) {
             Some(k) => (k, k + 1),
             None => (rest.len(), rest.len()),
@@ -87,6 +133,7 @@ fn parse_job(p: &RowParser<'_>, has_time: bool, bytes: &[u8], out: &mut Parsed) 
         line += 1;
         if len as u64 >= MAX_LINE_BYTES {
             out.error = Some(long_line(&p.info.file, line));
+            out.error_bytes = pos as u64;
             break;
         }
         pos += consumed;
@@ -104,6 +151,7 @@ fn parse_job(p: &RowParser<'_>, has_time: bool, bytes: &[u8], out: &mut Parsed) 
                 v.truncate(out.rows);
             }
             out.error = Some(e);
+            out.error_bytes = pos as u64;
             break;
         }
         if has_time {
@@ -285,7 +333,6 @@ impl<R: BufRead + Send> RecordingReader<R> {
                 let (jt, jr) = mpsc::sync_channel::<Job>(1);
                 let (rt, rr) = mpsc::sync_channel::<Parsed>(1);
                 let (ft, fr) = mpsc::channel::<Parsed>();
-                let free_buf_tx = free_buf_tx.clone();
                 let info = &info;
                 scope.spawn(move || {
                     for job in jr {
@@ -294,7 +341,7 @@ impl<R: BufRead + Send> RecordingReader<R> {
                         match job {
                             Job::Lines(b) => {
                                 parse_job(&parser, has_time, &b, &mut out);
-                                free_buf_tx.send(b).ok();
+                                out.text = b;
                             }
                             Job::Io(error) => {
                                 out.error = Some(RecordingError::Io {
@@ -312,13 +359,12 @@ impl<R: BufRead + Send> RecordingReader<R> {
                 res_rx.push(rr);
                 free_res.push(ft);
             }
-            drop(free_buf_tx);
             scope.spawn(move || split(src, (carry, eof), job_bytes, job_tx, free_buf_rx));
             // `chunk` holds the rows read ahead at open that did not fill a chunk (maybe none)
             let mut result = Ok(true);
             'jobs: for k in 0.. {
                 let w = k % workers;
-                let Ok(p) = res_rx[w].recv() else { break };
+                let Ok(mut p) = res_rx[w].recv() else { break };
                 let mut r = 0;
                 while r < p.rows {
                     if chunk.len() == max_rows {
@@ -341,6 +387,8 @@ impl<R: BufRead + Send> RecordingReader<R> {
                             Err(e) => {
                                 good = i - r;
                                 result = Err(e);
+                                // the serial reader has consumed the row's line
+                                bytes += p.bytes_through(p.line_of(i) + 1);
                                 break;
                             }
                         }
@@ -361,11 +409,13 @@ impl<R: BufRead + Send> RecordingReader<R> {
                         break;
                     }
                     shift_line(&mut e, line_no);
+                    bytes += p.error_bytes;
                     result = Err(e);
                     break;
                 }
                 line_no += p.lines;
                 bytes += p.bytes;
+                free_buf_tx.send(std::mem::take(&mut p.text)).ok();
                 free_res[w].send(p).ok();
             }
             drop(res_rx);
