@@ -173,7 +173,15 @@ mod tests {
     /// Extreme finite values (x·0 = ±0 for each) pass, in every lane and in the tail.
     #[test]
     fn extreme_finite_values_are_finite() {
-        let extremes = [f64::MAX, f64::MIN, -0.0, f64::MIN_POSITIVE, 5e-324, -5e-324, 1e308];
+        let extremes = [
+            f64::MAX,
+            f64::MIN,
+            -0.0,
+            f64::MIN_POSITIVE,
+            5e-324,
+            -5e-324,
+            1e308,
+        ];
         for len in [1, 7, 8, 9, 63, 64, 65, 130] {
             let v: Vec<f64> = (0..len).map(|i| extremes[i % extremes.len()]).collect();
             assert_eq!(first_non_finite(&v), None, "len {len}");
