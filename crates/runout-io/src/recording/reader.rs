@@ -1533,8 +1533,10 @@ mod tests {
         (out, error, r.bytes_read(), r.warnings().to_vec())
     }
 
-    /// A line of each form the common-row path must hand back (or, for the first, take), for
-    /// the row of time `t` (issue 18).
+    /// Line `form` of the forms the common-row path must either take (signs, `.5`, `5.`,
+    /// `-0.000`, a long fraction) or hand back to the full path (exponents, blanks, quotes, a
+    /// lone `\r`, fields missing or extra, long mantissas, text, times off), for the row of
+    /// time `t` (issue 18).
     fn odd_line(form: usize, t: &str) -> String {
         match form {
             0 => format!("{t},1.5e2,-3"),

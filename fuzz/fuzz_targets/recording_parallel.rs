@@ -1,0 +1,70 @@
+//! Differential: a text recording's rows parsed in jobs on two threads
+//! (`RecordingReader::for_each_chunk_in_jobs_of`, the common-row path and its hand-back)
+//! against `read_chunk` in a loop, on 1100 well-formed rows followed by the fuzzer's bytes as
+//! more lines (the parallel path starts after the 1000 rows read ahead at open). Chunks (sizes,
+//! first samples, times and values bit for bit), the first error, the bytes read and the
+//! warnings must be the same.
+#![no_main]
+use libfuzzer_sys::fuzz_target;
+use runout_io::recording::{ReadOptions, RecordingChunk, RecordingReader};
+
+type Seen = (Vec<(u64, Vec<u64>, Vec<Vec<u64>>)>, Option<String>, u64, Vec<String>);
+
+fn bits(c: &RecordingChunk) -> (u64, Vec<u64>, Vec<Vec<u64>>) {
+    (
+        c.first_sample,
+        c.time_s.iter().map(|t| t.to_bits()).collect(),
+        c.values.iter().map(|v| v.iter().map(|x| x.to_bits()).collect()).collect(),
+    )
+}
+
+fuzz_target!(|data: &[u8]| {
+    let Some((&knobs, tail)) = data.split_first() else {
+        return;
+    };
+    let delim = [b',', b';', b'\t'][usize::from(knobs % 3)];
+    let crlf = knobs & 4 != 0;
+    let job_bytes = 16 + usize::from(knobs >> 3) * 37;
+    let d = delim as char;
+    let end = if crlf { "\r\n" } else { "\n" };
+    let mut text = format!("time_s{d}a_N{d}b_N{end}");
+    for k in 0..1100u32 {
+        let a = if delim == b';' && knobs & 64 != 0 {
+            format!("{:.3}", f64::from(k) * 0.7 - 300.0).replace('.', ",")
+        } else {
+            format!("{:.3}", f64::from(k) * 0.7 - 300.0)
+        };
+        text += &format!("{:.4}{d}{a}{d}-{}.25{end}", f64::from(k) / 1e4, k % 7);
+    }
+    let mut bytes = text.into_bytes();
+    bytes.extend_from_slice(tail);
+    let opts = ReadOptions::new();
+    let Ok(mut serial) = RecordingReader::from_bytes("f.csv", &bytes, &opts) else {
+        return;
+    };
+    let mut c = RecordingChunk::default();
+    let mut want: Seen = (Vec::new(), None, 0, Vec::new());
+    want.1 = loop {
+        match serial.read_chunk(&mut c, 333) {
+            Ok(0) => break None,
+            Ok(_) => want.0.push(bits(&c)),
+            Err(e) => break Some(e.to_string()),
+        }
+    };
+    want.2 = serial.bytes_read();
+    want.3 = serial.warnings().to_vec();
+    let mut parallel = RecordingReader::from_bytes("f.csv", &bytes, &opts).expect("opened once");
+    let mut got: Seen = (Vec::new(), None, 0, Vec::new());
+    let mut chunks = Vec::new();
+    got.1 = parallel
+        .for_each_chunk_in_jobs_of(job_bytes, &mut c, 333, 2, |c, _, _| {
+            chunks.push(bits(c));
+            true
+        })
+        .err()
+        .map(|e| e.to_string());
+    got.0 = chunks;
+    got.2 = parallel.bytes_read();
+    got.3 = parallel.warnings().to_vec();
+    assert!(got == want, "{:?}\n{:?}\n{} {}", got.1, want.1, got.2, want.2);
+});
