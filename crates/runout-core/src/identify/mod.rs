@@ -61,7 +61,8 @@ pub use mean_force::{
     MeanForceCalibration, MeanForceDesign, MeanForces,
 };
 pub use model::{
-    coefficient_gradient, force_from_basis, runout_gradient, BasisSums, RevolutionModel, NB, ND,
+    coefficient_gradient, force_from_basis, on_pool, runout_gradient, BasisSums, RevolutionModel,
+    NB, ND,
 };
 pub use multi_test::{analyse_tests, MultiTestResult, TestResult};
 pub use peak_coefficients::{coefficients_at_peak, PeakCoefficients};

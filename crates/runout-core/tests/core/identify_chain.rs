@@ -445,3 +445,17 @@ fn fitted_modes_fit_is_identical_at_any_thread_count() {
     assert_eq!(one, run(2), "1 vs 2 threads");
     assert_eq!(one, run(3), "1 vs 3 threads");
 }
+
+/// [`on_pool`] runs a fit as one task on the thread pool with the grouping of its caller: the
+/// same fit, bit for bit, as the fit called from this thread, outside the pool (issue 18: the
+/// CLI runs its fits this way). The default number of disks: the model groups their sums by
+/// where it is called from, which is what `on_pool` must carry over.
+#[test]
+fn a_fit_on_the_pool_equals_the_fit_called_from_outside() {
+    let s = two_flute();
+    let cases = resonant_set(&s);
+    let options = chain_options(&s, fitted_modes(), true);
+    let here = format!("{:?}", full_signal_fit(&cases, &options).unwrap());
+    let pooled = on_pool(|| format!("{:?}", full_signal_fit(&cases, &options).unwrap()));
+    assert_eq!(here, pooled);
+}

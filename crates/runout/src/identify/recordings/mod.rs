@@ -71,6 +71,14 @@ pub fn recordings(
             .with_context(|| format!("analysing {}", src.name()))?;
         files.push(r);
     }
+    // the fits on the thread pool as one task: their parallel sections are nested there
+    // rather than each handed over from this thread (same results bit for bit)
+    runout_core::identify::on_pool(|| fit_and_report(req, files))
+}
+
+/// The fits after the reading: the mean-force calibration, the full-signal fit of all
+/// recordings, the chain check, the consistency and the verdicts, into the report.
+fn fit_and_report(req: &RecordingsRequest, mut files: Vec<FileResult>) -> Result<RecordingsReport> {
     let calibration = fit::mean_force_calibration(req, &files);
     let guess = calibration
         .as_ref()
