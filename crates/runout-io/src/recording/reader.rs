@@ -979,6 +979,9 @@ impl RowParser<'_> {
         if text.chars().count() > 40 {
             text = text.chars().take(40).collect::<String>() + "…";
         }
+        // control characters escaped: a lone `\r` printed raw sent a terminal's cursor back
+        // over the file and line of the message
+        let text = crate::textfile::quote(&text);
         RecordingError::NotNumeric {
             file: self.info.file.clone(),
             line,
@@ -1513,6 +1516,21 @@ mod tests {
             .err()
             .map(|e| e.to_string());
         (out, error, r.bytes_read(), r.warnings().to_vec())
+    }
+
+    /// A cell holding a control character (a lone carriage return, a tab in a comma-separated
+    /// file) is quoted escaped in the error, so that the message stays readable on a terminal.
+    #[test]
+    fn control_characters_in_a_bad_cell_are_escaped() {
+        let text = "time_s,a_N\n0.0,1\n0.1,1\r5\n";
+        let mut r =
+            RecordingReader::from_bytes("c.csv", text.as_bytes(), &ReadOptions::new()).unwrap();
+        let e = r
+            .read_chunk(&mut RecordingChunk::default(), 10)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("c.csv:3:2: `1\\r5`"), "{e}");
+        assert!(!e.contains('\r'), "{e:?}");
     }
 
     /// [`parallel`] with jobs of `job_bytes`.
