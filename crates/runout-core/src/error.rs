@@ -21,12 +21,19 @@ pub struct ParamError {
 }
 
 impl ParamError {
-    /// Build an error for parameter `param`.
+    /// Build an error for parameter `param`. A number rendered longer than 16 characters (an
+    /// `f64`'s `Display` writes 1e-255 with 255 zeros) is given in scientific notation instead
+    /// ([`crate::limits::show`]), so that every message stays short.
     pub fn new(param: impl Into<String>, expected: impl Into<String>, got: impl ToString) -> Self {
+        let got = got.to_string();
+        let got = match got.parse::<f64>() {
+            Ok(v) if got.len() > 16 => crate::limits::show(v),
+            _ => got,
+        };
         ParamError {
             param: param.into(),
             expected: expected.into(),
-            got: got.to_string(),
+            got,
         }
     }
 }
@@ -67,5 +74,21 @@ pub(crate) fn finite(param: &str, value: f64) -> Result<f64, ParamError> {
             "a finite number",
             crate::limits::show(value),
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ParamError;
+
+    /// Extreme numbers are rendered short (scientific), other values as given.
+    #[test]
+    fn extreme_numbers_are_shown_short() {
+        let e = ParamError::new("step_deg", "an angular step in (0, 90] degrees", 4.9e255);
+        assert_eq!(e.got, "4.9e255");
+        assert!(e.to_string().len() < 100, "{e}");
+        assert_eq!(ParamError::new("x", "y", 3.9e-255).got, "3.9e-255");
+        assert_eq!(ParamError::new("x", "y", 12.5).got, "12.5");
+        assert_eq!(ParamError::new("x", "y", "a name").got, "a name");
     }
 }

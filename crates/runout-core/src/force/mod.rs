@@ -60,7 +60,7 @@ impl Sampling {
             return Err(ParamError::new(
                 "step_deg",
                 "an angular step in (0, 90] degrees",
-                step_deg,
+                crate::limits::show(step_deg),
             ));
         }
         crate::limits::count("disks", disks, crate::limits::MAX_DISKS)?;

@@ -211,11 +211,16 @@ pub fn simulate(req: &SimulateRequest) -> Result<SimulateReport> {
     let oversample = if sensor.is_some() { OVERSAMPLE } else { 1 };
     if let Some(fs) = req.sample_rate_hz {
         if fs.is_nan() || fs <= 0.0 {
-            bail!("--sample-rate-hz: expected a sample rate > 0 Hz, got {fs}");
+            bail!(
+                "--sample-rate-hz: expected a sample rate > 0 Hz, got {}",
+                runout_core::limits::show(fs)
+            );
         }
         let step_deg = 360.0 * case.cut.rpm() / 60.0 / fs / oversample as f64;
         case.sampling = Sampling::new(case.sampling.revolutions, step_deg, case.sampling.disks)
-            .map_err(|e| anyhow::anyhow!("--sample-rate-hz {fs}: {e}"))?;
+            .map_err(|e| {
+                anyhow::anyhow!("--sample-rate-hz {}: {e}", runout_core::limits::show(fs))
+            })?;
         case.check_work()?;
     }
     let series = simulate_series(&case)?;
