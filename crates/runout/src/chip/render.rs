@@ -132,10 +132,12 @@ pub fn eval_angle_plot(
     let hs = &case.spec.heights_mm;
     let z = match height_mm {
         None => hs.iter().copied().fold(f64::INFINITY, f64::min),
-        Some(z) => *hs
-            .iter()
-            .find(|h| (**h - z).abs() < 1e-9)
-            .ok_or_else(|| anyhow::anyhow!("--plot-height-mm {z}: not one of heights_mm {hs:?}"))?,
+        Some(z) => *hs.iter().find(|h| (**h - z).abs() < 1e-9).ok_or_else(|| {
+            anyhow::anyhow!(
+                "--plot-height-mm {}: not one of heights_mm {hs:?}",
+                runout_core::limits::show(z)
+            )
+        })?,
     };
     let kin = &case.kin;
     let h = &r.detail.h_mm;

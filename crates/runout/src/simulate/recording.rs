@@ -52,7 +52,11 @@ pub fn channels(
 ) -> Result<RecordingDetail> {
     let (pct, air) = (o.noise_percent, o.air_cut_s);
     if !(pct >= 0.0 && air >= 0.0) {
-        bail!("--noise-percent and --air-cut-s must be >= 0 (got {pct}, {air})");
+        bail!(
+            "--noise-percent and --air-cut-s must be >= 0 (got {}, {})",
+            runout_core::limits::show(pct),
+            runout_core::limits::show(air)
+        );
     }
     runout_core::limits::result_size("--air-cut-s", 2.0 * air * fs + s.fx.len() as f64, 3.0)?;
     let peak = s.fxy().into_iter().fold(0.0, f64::max);

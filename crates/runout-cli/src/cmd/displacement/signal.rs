@@ -76,7 +76,11 @@ pub fn run(a: Args) -> Result<()> {
     };
     if let (Some(f), Some(t)) = (section.from_s, section.to_s) {
         if t <= f {
-            bail!("--to-s ({t} s) must be after --from-s ({f} s)");
+            bail!(
+                "--to-s ({} s) must be after --from-s ({} s)",
+                runout_core::limits::show(t),
+                runout_core::limits::show(f)
+            );
         }
     }
     let sensor_angles_rad = a
