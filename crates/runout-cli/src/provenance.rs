@@ -1,21 +1,48 @@
 //! Provenance of this run (issue 21 item 6): the command line, and the name, size and SHA-256 of
 //! every file named on it (a recording given as `FILE:SELECTOR` counts as `FILE`), hashed on a
 //! background thread while the job runs (hashing a long recording costs about as much as reading
-//! it once). The thread runs at the lowest scheduling priority (nice 19 on Linux), so it takes
-//! the cores only when the job leaves one idle — during its fits, which run on one core — instead
-//! of slowing the reading, which keeps both busy (issue 18: −0.05 s on a 100 MB `identify`).
-//! Every JSON report carries it
-//! as `provenance` ([`stamped_json`]) and every plot in its metadata
-//! (`runout_io::plot::metadata`).
+//! it once).
+//!
+//! The background thread runs under Linux's `SCHED_IDLE` policy: only on a core the job leaves
+//! idle (between the reading's threads, during the fits), and a job thread that wakes takes the
+//! core back at once. At nice 19 (before) it still held a core for a time slice when a parse
+//! worker woke: +0.02 s on a 100 MB `identify`, against +0.01 s now (issue 18).
+//!
+//! A thread that runs only on idle cores may not run at all on a busy machine, so nothing ever
+//! waits for it: it publishes a checkpoint ([`InputHashing`]'s clone) every 1 MiB, and when the
+//! report is ready the writing thread stops it and finishes the hashing itself from the latest
+//! checkpoint, at its own priority ([`settle`]).
+//!
+//! Every JSON report carries it as `provenance` ([`stamped_json`]) and every plot in its
+//! metadata (`runout_io::plot::metadata`).
 
-use runout::provenance::{Provenance, Stamped};
+use runout::provenance::{InputHashing, Provenance, Stamped};
 use runout::{Report, Source};
 use std::path::Path;
-use std::sync::{Mutex, OnceLock};
-use std::thread::JoinHandle;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
 
-static PENDING: Mutex<Option<JoinHandle<std::io::Result<Provenance>>>> = Mutex::new(None);
+static PENDING: Mutex<Option<Pending>> = Mutex::new(None);
 static DONE: OnceLock<Outcome> = OnceLock::new();
+
+/// Steps of [`InputHashing::step`] (64 KiB each) between two checkpoints: 1 MiB.
+const CHECKPOINT_STEPS: u64 = 16;
+
+/// The hashing under way: the command line and what the background thread shares with the
+/// thread that will finish it.
+struct Pending {
+    args: Vec<String>,
+    shared: Arc<Shared>,
+}
+
+/// Between the background thread and the finishing one.
+struct Shared {
+    /// The latest checkpoint (the start, until the first is published), or the error that
+    /// stopped the background thread. Held only to swap a value in or out.
+    latest: Mutex<Result<InputHashing, String>>,
+    /// Set when the finishing thread has taken over: the background thread stops.
+    stop: AtomicBool,
+}
 
 /// What the hashing thread ended with.
 #[derive(Debug)]
@@ -25,7 +52,7 @@ enum Outcome {
     /// Every input hashed.
     Done(Provenance),
     /// Why there is no provenance (an input could not be read to hash it, which names the file
-    /// and the error, or the thread panicked).
+    /// and the error).
     Failed(String),
 }
 
@@ -33,29 +60,82 @@ enum Outcome {
 /// metadata provider.
 pub fn start(args: Vec<String>) {
     let inputs: Vec<Source> = input_files(&args).into_iter().map(Source::path).collect();
-    let handle = std::thread::spawn(move || {
-        lowest_priority();
-        Provenance::new(args, &inputs)
+    let hashing = InputHashing::new(inputs);
+    let shared = Arc::new(Shared {
+        latest: Mutex::new(Ok(hashing.clone())),
+        stop: AtomicBool::new(false),
     });
-    *PENDING.lock().unwrap_or_else(|e| e.into_inner()) = Some(handle);
+    let background = Arc::clone(&shared);
+    std::thread::spawn(move || {
+        lowest_priority();
+        hash_in_background(hashing, &background);
+    });
+    *PENDING.lock().unwrap_or_else(|e| e.into_inner()) = Some(Pending { args, shared });
     runout_io::plot::metadata::set_provider(Some(Box::new(|| get().map(Provenance::summary_line))));
 }
 
-/// Lowers the calling thread's scheduling priority to the lowest (nice 19): on Linux the nice
-/// value is per thread, so the job's own threads keep theirs. Best effort: a failure leaves the
-/// priority as it was (the hash is the same either way).
-fn lowest_priority() {
-    #[cfg(target_os = "linux")]
-    // SAFETY: gettid and setpriority take no pointers; they only read and set this thread's
-    // scheduling attributes.
-    unsafe {
-        let tid = libc::syscall(libc::SYS_gettid) as libc::id_t;
-        libc::setpriority(libc::PRIO_PROCESS, tid, 19);
+/// The background thread: steps through the inputs, publishing a checkpoint every
+/// [`CHECKPOINT_STEPS`] steps, the finished hashing at the end or the error that stopped it;
+/// returns early once the finishing thread has taken over.
+fn hash_in_background(mut hashing: InputHashing, shared: &Shared) {
+    let publish = |value: Result<InputHashing, String>| {
+        let old = std::mem::replace(
+            &mut *shared.latest.lock().unwrap_or_else(|e| e.into_inner()),
+            value,
+        );
+        drop(old); // outside the lock
+    };
+    let mut steps = 0u64;
+    while !shared.stop.load(Ordering::Relaxed) {
+        match hashing.step() {
+            Ok(true) => return publish(Ok(hashing)),
+            Ok(false) => {
+                steps += 1;
+                if steps.is_multiple_of(CHECKPOINT_STEPS) {
+                    publish(Ok(hashing.clone()));
+                }
+            }
+            Err(e) => return publish(Err(e.to_string())),
+        }
     }
 }
 
-/// The provenance of this run (waits for the hashing to finish); `None` if [`start`] was not
-/// called or an input could not be read ([`stamped_json`] tells the user why).
+/// The finishing side: stops the background thread and finishes the hashing on this thread
+/// from the latest checkpoint (at once when the background thread has finished it).
+fn settle(pending: Pending) -> Outcome {
+    pending.shared.stop.store(true, Ordering::Relaxed);
+    let latest = std::mem::replace(
+        &mut *pending
+            .shared
+            .latest
+            .lock()
+            .unwrap_or_else(|e| e.into_inner()),
+        Err(String::new()),
+    );
+    match latest.and_then(|h| h.finish().map_err(|e| e.to_string())) {
+        Ok(inputs) => Outcome::Done(Provenance::of_inputs(pending.args, inputs)),
+        Err(why) => Outcome::Failed(why),
+    }
+}
+
+/// Puts the calling thread under Linux's `SCHED_IDLE` policy (it runs only when a core would
+/// otherwise be idle), and at the lowest nice value where that is refused. On Linux the policy
+/// and the nice value are per thread, so the job's own threads keep theirs. Best effort: a
+/// failure leaves the thread as it was (the hash is the same either way).
+fn lowest_priority() {
+    #[cfg(target_os = "linux")]
+    // SAFETY: gettid takes no pointer; setpriority reads and sets this thread's scheduling
+    // attributes; sched_setscheduler reads `param`, which lives across the call.
+    unsafe {
+        let tid = libc::syscall(libc::SYS_gettid) as libc::pid_t;
+        libc::setpriority(libc::PRIO_PROCESS, tid as libc::id_t, 19);
+        let param = libc::sched_param { sched_priority: 0 };
+        libc::sched_setscheduler(tid, libc::SCHED_IDLE, &param);
+    }
+}
+
+/// The provenance of this run (finishes the hashing); `None` if [`start`] was not called or
+/// an input could not be read ([`stamped_json`] tells the user why).
 pub fn get() -> Option<&'static Provenance> {
     match outcome() {
         Outcome::Done(p) => Some(p),
@@ -63,20 +143,16 @@ pub fn get() -> Option<&'static Provenance> {
     }
 }
 
-/// The hashing thread's result, waited for once; a failure is told on stderr then (once, unless
-/// `--quiet`): the outputs go without provenance. The wait ends when the thread does: it only
-/// reads the input files to their end (regular files: [`input_files`] names no FIFO or device),
-/// and a panic in it is a [`Outcome::Failed`], not a hang.
+/// The hashing's result, settled once ([`settle`]); a failure is told on stderr then (once,
+/// unless `--quiet`): the outputs go without provenance. It never waits for the background
+/// thread: it reads the rest of the input files itself (regular files: [`input_files`] names
+/// no FIFO or device).
 fn outcome() -> &'static Outcome {
     DONE.get_or_init(|| {
-        let Some(handle) = PENDING.lock().unwrap_or_else(|e| e.into_inner()).take() else {
+        let Some(pending) = PENDING.lock().unwrap_or_else(|e| e.into_inner()).take() else {
             return Outcome::NotStarted;
         };
-        let outcome = match handle.join() {
-            Ok(Ok(p)) => Outcome::Done(p),
-            Ok(Err(e)) => Outcome::Failed(e.to_string()),
-            Err(_) => Outcome::Failed("the thread hashing the inputs panicked".to_string()),
-        };
+        let outcome = settle(pending);
         if let Some(w) = warning(&outcome) {
             crate::progress::warn(&w);
         }
@@ -370,6 +446,76 @@ mod tests {
             serde_json::from_str(&json_with(&report(), &done).unwrap()).unwrap();
         assert_eq!(v["provenance"]["command_line"][1], "x");
         assert_eq!(warning(&done), None);
+    }
+
+    fn pending(inputs: Vec<Source>) -> (Pending, InputHashing) {
+        let hashing = InputHashing::new(inputs);
+        let shared = Arc::new(Shared {
+            latest: Mutex::new(Ok(hashing.clone())),
+            stop: AtomicBool::new(false),
+        });
+        let args = vec!["runout".to_string(), "x".to_string()];
+        (Pending { args, shared }, hashing)
+    }
+
+    /// The hashing is finished by the thread that needs it, whatever the background thread did:
+    /// nothing (a thread that a busy machine never schedules), part of it (stopped while it
+    /// runs), or all of it; the hashes are those of `InputFile::of` each time.
+    #[test]
+    fn the_waiting_thread_finishes_the_hashing_itself() {
+        let dir = tempfile::tempdir().unwrap();
+        let files: Vec<Source> = [3 << 20, 10, 0]
+            .iter()
+            .enumerate()
+            .map(|(i, &len)| {
+                let p = dir.path().join(format!("r{i}.txt"));
+                std::fs::write(&p, (0..len).map(|k| (k % 253) as u8).collect::<Vec<u8>>()).unwrap();
+                Source::path(p)
+            })
+            .collect();
+        let expected: Vec<_> = files
+            .iter()
+            .map(|f| runout::provenance::InputFile::of(f).unwrap())
+            .collect();
+        let hashes = |o: Outcome| match o {
+            Outcome::Done(p) => {
+                assert_eq!(p.command_line, ["runout", "x"]);
+                p.inputs
+            }
+            other => panic!("{other:?}"),
+        };
+        // never scheduled
+        let (p, _) = pending(files.clone());
+        assert_eq!(hashes(settle(p)), expected);
+        // stopped after its first checkpoint (the rest read by the finishing thread)
+        let (p, mut h) = pending(files.clone());
+        for _ in 0..CHECKPOINT_STEPS + 3 {
+            h.step().unwrap();
+        }
+        *p.shared.latest.lock().unwrap() = Ok(h.clone());
+        assert_eq!(hashes(settle(p)), expected);
+        // running while the report is settled, and run to its end
+        for wait in [false, true] {
+            let (p, h) = pending(files.clone());
+            let shared = Arc::clone(&p.shared);
+            let t = std::thread::spawn(move || hash_in_background(h, &shared));
+            if wait {
+                t.join().unwrap();
+            }
+            assert_eq!(hashes(settle(p)), expected);
+        }
+    }
+
+    /// An input the background thread could not read: no provenance, and the reason names it.
+    #[test]
+    fn a_read_error_of_the_background_thread_is_the_outcome() {
+        let dir = tempfile::tempdir().unwrap();
+        let (p, h) = pending(vec![Source::path(dir.path().join("gone.txt"))]);
+        hash_in_background(h, &p.shared);
+        match settle(p) {
+            Outcome::Failed(why) => assert!(why.contains("gone.txt"), "{why}"),
+            other => panic!("{other:?}"),
+        }
     }
 
     /// `stamped_json` without provenance (here: never started) returns, within a bound (a

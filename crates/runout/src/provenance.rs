@@ -22,7 +22,7 @@ use crate::job::Source;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
-use std::io::Read;
+use std::io::{Read, Seek};
 
 /// Where a report came from.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
@@ -59,12 +59,23 @@ impl Provenance {
         I: IntoIterator<Item = S>,
         S: Into<String>,
     {
-        Ok(Self {
+        let inputs = inputs.iter().map(InputFile::of).collect::<Result<_, _>>()?;
+        Ok(Self::of_inputs(command_line, inputs))
+    }
+
+    /// Provenance of a report made now by this program from inputs already hashed (e.g. by
+    /// [`InputHashing`]), for the command line `command_line`.
+    pub fn of_inputs<I, S>(command_line: I, inputs: Vec<InputFile>) -> Self
+    where
+        I: IntoIterator<Item = S>,
+        S: Into<String>,
+    {
+        Self {
             tool: format!("runout {}", env!("CARGO_PKG_VERSION")),
             command_line: command_line.into_iter().map(Into::into).collect(),
-            inputs: inputs.iter().map(InputFile::of).collect::<Result<_, _>>()?,
+            inputs,
             created_utc: utc_now_rfc3339(),
-        })
+        }
     }
 
     /// One line for the metadata of a plot: tool, time, command line and the inputs' hashes
@@ -92,10 +103,10 @@ impl InputFile {
         let size_bytes = match source.as_path() {
             Some(path) => {
                 let mut file = std::fs::File::open(path).map_err(|e| named(source, e))?;
-                let mut buf = vec![0u8; 1 << 16];
+                let mut buf = vec![0u8; STEP_BYTES];
                 let mut total = 0u64;
                 loop {
-                    let n = file.read(&mut buf).map_err(|e| named(source, e))?;
+                    let n = read_some(&mut file, &mut buf, source)?;
                     if n == 0 {
                         break;
                     }
@@ -104,32 +115,167 @@ impl InputFile {
                 }
                 total
             }
-            None => match source.as_arrays() {
-                // arrays: each channel's name, a NUL, then its samples as little-endian f64
-                Some(arrays) => {
-                    let mut total = 0u64;
-                    for (name, samples) in &arrays.columns {
-                        hasher.update(name.as_bytes());
-                        hasher.update([0u8]);
-                        for v in samples.iter() {
-                            hasher.update(v.to_le_bytes());
-                        }
-                        total += name.len() as u64 + 1 + 8 * samples.len() as u64;
-                    }
-                    total
-                }
-                None => {
-                    let bytes = source.as_bytes().unwrap_or_default();
-                    hasher.update(bytes);
-                    bytes.len() as u64
-                }
-            },
+            None => hash_in_memory(source, &mut hasher),
         };
-        Ok(Self {
+        Ok(Self::finished(source, size_bytes, hasher))
+    }
+
+    fn finished(source: &Source, size_bytes: u64, hasher: Sha256) -> Self {
+        Self {
             name: source.name().to_string(),
             size_bytes,
             sha256: hex(&hasher.finalize()),
-        })
+        }
+    }
+}
+
+/// Bytes read and hashed per [`InputHashing::step`].
+const STEP_BYTES: usize = 1 << 16;
+
+/// The SHA-256 of a list of inputs computed in steps of at most 64 KiB, so that the work can
+/// change threads: a clone is a checkpoint — the inputs done, the hash state and the position
+/// in the current input, not its open file, which the clone opens again and seeks to when it
+/// goes on. The CLI hashes on a background thread that runs only on otherwise idle cores, and
+/// when the report is ready goes on from the latest checkpoint on its own thread rather than
+/// wait for the background one (which a busy machine may not schedule for long).
+///
+/// ```
+/// use runout::provenance::{InputFile, InputHashing};
+/// use runout::Source;
+/// let inputs = vec![Source::bytes("a.csv", b"t,Fx\n0,1\n".to_vec())];
+/// let mut hashing = InputHashing::new(inputs.clone());
+/// let checkpoint = hashing.clone();
+/// while !hashing.step()? {}
+/// // the checkpoint, finished elsewhere, gives the same hashes
+/// assert_eq!(checkpoint.finish()?, hashing.finish()?);
+/// assert_eq!(InputHashing::new(inputs.clone()).finish()?, vec![InputFile::of(&inputs[0])?]);
+/// # Ok::<(), std::io::Error>(())
+/// ```
+#[derive(Debug)]
+pub struct InputHashing {
+    inputs: std::sync::Arc<[Source]>,
+    /// The inputs hashed, in order (the first `done.len()` inputs).
+    done: Vec<InputFile>,
+    /// The hash state of the current input.
+    hasher: Sha256,
+    /// Bytes of the current input hashed.
+    offset: u64,
+    /// The current input, open at `offset` (not carried by a clone).
+    file: Option<std::fs::File>,
+    /// Read buffer (not carried by a clone).
+    buf: Vec<u8>,
+}
+
+impl Clone for InputHashing {
+    fn clone(&self) -> Self {
+        Self {
+            inputs: self.inputs.clone(),
+            done: self.done.clone(),
+            hasher: self.hasher.clone(),
+            offset: self.offset,
+            file: None,
+            buf: Vec::new(),
+        }
+    }
+}
+
+impl InputHashing {
+    /// Nothing hashed yet.
+    pub fn new(inputs: Vec<Source>) -> Self {
+        Self {
+            inputs: inputs.into(),
+            done: Vec::new(),
+            hasher: Sha256::new(),
+            offset: 0,
+            file: None,
+            buf: Vec::new(),
+        }
+    }
+
+    /// True when every input is hashed.
+    pub fn is_done(&self) -> bool {
+        self.done.len() == self.inputs.len()
+    }
+
+    /// Hash the next at most 64 KiB of the current input (an in-memory source at once); true
+    /// when every input is hashed. An input that cannot be opened or read is an error naming
+    /// it (the state is then unchanged: a later step tries the same read again).
+    pub fn step(&mut self) -> std::io::Result<bool> {
+        let inputs = std::sync::Arc::clone(&self.inputs);
+        let Some(source) = inputs.get(self.done.len()) else {
+            return Ok(true);
+        };
+        let Some(path) = source.as_path() else {
+            let size = hash_in_memory(source, &mut self.hasher);
+            self.close_input(source, size);
+            return Ok(self.is_done());
+        };
+        if self.file.is_none() {
+            let mut f = std::fs::File::open(path).map_err(|e| named(source, e))?;
+            if self.offset > 0 {
+                f.seek(std::io::SeekFrom::Start(self.offset))
+                    .map_err(|e| named(source, e))?;
+            }
+            self.file = Some(f);
+        }
+        self.buf.resize(STEP_BYTES, 0);
+        let file = self.file.as_mut().expect("opened above");
+        let n = read_some(file, &mut self.buf, source)?;
+        if n == 0 {
+            self.close_input(source, self.offset);
+        } else {
+            self.hasher.update(&self.buf[..n]);
+            self.offset += n as u64;
+        }
+        Ok(self.is_done())
+    }
+
+    /// Step to the end; the inputs' names, sizes and hashes in order.
+    pub fn finish(mut self) -> std::io::Result<Vec<InputFile>> {
+        while !self.step()? {}
+        Ok(self.done)
+    }
+
+    fn close_input(&mut self, source: &Source, size_bytes: u64) {
+        let hasher = std::mem::take(&mut self.hasher);
+        self.done
+            .push(InputFile::finished(source, size_bytes, hasher));
+        self.offset = 0;
+        self.file = None;
+    }
+}
+
+/// Hash an in-memory source (bytes, or named arrays: each channel's name, a NUL, then its
+/// samples as little-endian f64); its size in that form.
+fn hash_in_memory(source: &Source, hasher: &mut Sha256) -> u64 {
+    match source.as_arrays() {
+        Some(arrays) => {
+            let mut total = 0u64;
+            for (name, samples) in &arrays.columns {
+                hasher.update(name.as_bytes());
+                hasher.update([0u8]);
+                for v in samples.iter() {
+                    hasher.update(v.to_le_bytes());
+                }
+                total += name.len() as u64 + 1 + 8 * samples.len() as u64;
+            }
+            total
+        }
+        None => {
+            let bytes = source.as_bytes().unwrap_or_default();
+            hasher.update(bytes);
+            bytes.len() as u64
+        }
+    }
+}
+
+/// One read into `buf` (again when interrupted); errors name the source.
+fn read_some(file: &mut std::fs::File, buf: &mut [u8], source: &Source) -> std::io::Result<usize> {
+    loop {
+        match file.read(buf) {
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            r => return r.map_err(|e| named(source, e)),
+        }
     }
 }
 
@@ -211,6 +357,65 @@ mod tests {
         assert_eq!(InputFile::of(&Source::path(&p)).unwrap().sha256, i.sha256);
         let missing = InputFile::of(&Source::path(dir.path().join("none.csv"))).unwrap_err();
         assert!(missing.to_string().contains("none.csv"), "{missing}");
+    }
+
+    /// A checkpoint taken after any number of steps, finished on its own (it opens the file
+    /// again and seeks), gives the hashes of [`InputFile::of`] — across files of 0, 1 step, a
+    /// step and 7 bytes, three steps, and in-memory bytes between them; the original goes on
+    /// unaffected by its clones.
+    #[test]
+    fn a_checkpoint_finished_elsewhere_gives_the_same_hashes() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut inputs = Vec::new();
+        for (i, len) in [STEP_BYTES + 7, 0, STEP_BYTES, 3 * STEP_BYTES]
+            .into_iter()
+            .enumerate()
+        {
+            let p = dir.path().join(format!("f{i}.bin"));
+            // content that differs per position (a shifted or repeated block changes the hash)
+            let bytes: Vec<u8> = (0..len).map(|k| (k * 31 + k / 251 + i) as u8).collect();
+            std::fs::write(&p, bytes).unwrap();
+            inputs.push(Source::path(p));
+            if i == 1 {
+                inputs.push(Source::bytes("mem", b"in memory".to_vec()));
+            }
+        }
+        let expected: Vec<InputFile> = inputs.iter().map(|s| InputFile::of(s).unwrap()).collect();
+        let mut hashing = InputHashing::new(inputs.clone());
+        let mut steps = 0;
+        loop {
+            let checkpoint = hashing.clone();
+            assert_eq!(
+                checkpoint.finish().unwrap(),
+                expected,
+                "checkpoint after {steps} steps"
+            );
+            steps += 1;
+            if hashing.step().unwrap() {
+                break;
+            }
+        }
+        // 3 + 1 + 1 + 2 + 4 steps: a file's last step reads its end
+        assert_eq!(steps, 11);
+        assert!(hashing.is_done());
+        assert_eq!(hashing.finish().unwrap(), expected);
+    }
+
+    /// An input that cannot be read stops the hashing with an error naming it, at every try.
+    #[test]
+    fn a_missing_input_is_an_error_naming_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let inputs = vec![
+            Source::bytes("mem", b"x".to_vec()),
+            Source::path(dir.path().join("gone.csv")),
+        ];
+        let mut hashing = InputHashing::new(inputs);
+        assert!(!hashing.step().unwrap());
+        for _ in 0..2 {
+            let e = hashing.step().unwrap_err();
+            assert!(e.to_string().contains("gone.csv"), "{e}");
+        }
+        assert!(!hashing.is_done());
     }
 
     #[test]
