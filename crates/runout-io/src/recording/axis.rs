@@ -23,7 +23,7 @@ pub struct AxisMapping {
 
 /// A malformed axis mapping text.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("axis mapping `{text}`: {message}")]
+#[error("axis mapping `{}`: {message}", crate::textfile::quote(.text))]
 pub struct AxisMappingError {
     /// The text given.
     pub text: String,
@@ -121,7 +121,10 @@ impl AxisMapping {
             }
         }
         if axes[0].is_none() || axes[1].is_none() {
-            let names: Vec<&str> = channels.iter().map(AsRef::as_ref).collect();
+            let names: Vec<String> = channels
+                .iter()
+                .map(|c| crate::textfile::quote(c.as_ref()))
+                .collect();
             return Err(AxisMappingError {
                 text: String::new(),
                 message: format!(
@@ -267,5 +270,21 @@ mod tests {
         assert_eq!(m.to_string(), "x = force_x_N, y = force_y_N");
         assert!(AxisMapping::identity_for(&["ch1", "ch2", "ch3"]).is_err());
         assert!(AxisMapping::identity_for(&["Fx", "Fz"]).is_err());
+    }
+
+    /// Channel names and the mapping text are user text: their control characters are escaped
+    /// in messages (a raw ESC or CR would drive the terminal instead of being shown).
+    #[test]
+    fn control_characters_in_messages_are_escaped() {
+        let e = AxisMapping::identity_for(&["ch\u{1b}[2J1", "ch\r2"]).unwrap_err();
+        let shown = e.to_string();
+        assert!(!shown.chars().any(char::is_control), "{shown:?}");
+        assert!(
+            shown.contains("ch\\u{1b}[2J1") && shown.contains("ch\\r2"),
+            "{shown}"
+        );
+        let e = AxisMapping::parse("x = F\u{7}x, w = Fy").unwrap_err();
+        let shown = e.to_string();
+        assert!(!shown.chars().any(char::is_control), "{shown:?}");
     }
 }

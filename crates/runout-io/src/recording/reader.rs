@@ -435,9 +435,9 @@ impl<R: BufRead> RecordingReader<R> {
                     file: file.clone(),
                     line: header.names_line,
                     message: format!(
-                        "time column `{}` has unit `{}`; expected s, ms or us",
-                        columns[i].header,
-                        columns[i].unit.clone().unwrap_or_default()
+                        "time column `{}` has unit `{}`; expected s, ms, us or min",
+                        crate::textfile::quote(&columns[i].header),
+                        crate::textfile::quote(&columns[i].unit.clone().unwrap_or_default())
                     ),
                 })?
             }
@@ -1300,6 +1300,27 @@ fn split_cells(s: &str, delimiter: u8) -> Vec<String> {
 mod tests {
     use super::*;
     use std::io::Cursor;
+
+    /// A time column with a unit other than s, ms, us or min: the message quotes the column's
+    /// name and unit (here the unit) with their control characters escaped (user text from the header; C0
+    /// controls such as ESC are refused as binary data before, C1 controls such as CSI U+009B
+    /// are valid UTF-8 text that a terminal may still obey).
+    #[test]
+    fn a_time_unit_error_escapes_the_header_text() {
+        let t = "time [h\u{9b}2J\u{85}],Fx\n0,1\n1,2\n2,3\n";
+        let e = RecordingReader::from_bytes("x.txt", t.as_bytes(), &ReadOptions::new())
+            .err()
+            .expect("an hour unit is refused");
+        let shown = e.to_string();
+        assert!(shown.contains("has unit"), "{shown}");
+        assert!(!shown.chars().any(char::is_control), "{shown:?}");
+        // (the name is the whole header cell; the unit is trimmed of white space, U+0085 too)
+        assert!(shown.contains("`time [h\\u{9b}2J\\u{85}]`"), "{shown}");
+        assert!(
+            shown.contains("unit `h\\u{9b}2J`; expected s, ms, us or min"),
+            "{shown}"
+        );
+    }
 
     /// A DynoWare `Sampling rate` that is no sample rate (0, negative, not finite, not a number)
     /// is ignored for the time column's step, as before, but no longer silently: a warning names
