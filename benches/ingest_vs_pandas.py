@@ -25,7 +25,11 @@ same whatever the recording's length, so `identify` is also timed on the first 3
 the same file: the difference gives the ingest rate proper (reading, mapping, the three passes
 of the signal pipeline) apart from that fixed cost.
 
-    python3 benches/ingest_vs_pandas.py [--mb 100] [--repeats 5] [--runout PATH] [--dir DIR]
+    python3 benches/ingest_vs_pandas.py [--mb 100] [--repeats 5] [--seed 1] [--runout PATH]
+        [--baseline OLD_BINARY] [--dir DIR]
+
+Each of `--repeats` rounds runs every measurement once (the whole file, its first lines, the
+baseline's two, pandas) in a shuffled order; medians are over the rounds.
 
 Needs pandas; builds nothing itself (pass --runout or build `target/release/runout` first).
 """
@@ -33,6 +37,7 @@ Needs pandas; builds nothing itself (pass --runout or build `target/release/runo
 import argparse
 import json
 import os
+import random
 import statistics
 import subprocess
 import sys
@@ -119,7 +124,8 @@ def strip(report):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--mb", type=float, default=100.0)
-    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--repeats", type=int, default=5, help="rounds (each measurement once per round, shuffled)")
+    ap.add_argument("--seed", type=int, default=1, help="seed of the rounds' shuffled order")
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     ap.add_argument("--runout", default=os.path.join(root, "target", "release", "runout"))
     ap.add_argument("--baseline", help="another runout binary (e.g. the previous build) timed in the same run")
@@ -151,30 +157,49 @@ def main():
             g.write(line)
     head_size = os.path.getsize(head)
 
-    def time_runout(binary, file=path):
-        cmd = [binary, "identify", file, "--config", toml, "--json", "-"]
-        times, peak, report = [], 0, None
-        cpu = []
-        for _ in range(args.repeats):
-            dt, out, rss = run_timed(cmd)
-            cpu.append(run_timed.cpu)
-            times.append(dt)
-            peak = max(peak, rss)
-            report = json.loads(out)
-        return times, peak, report, statistics.median(cpu)
+    # Rounds: in each, every measurement runs once, in a random order, so that a machine whose
+    # speed drifts during the run (a shared virtual machine) weighs on all of them alike; the
+    # medians are taken over the rounds (a fixed order once showed a baseline and a new binary
+    # equal where 25 shuffled rounds showed −8.5 %).
+    runs = {}
 
-    rust, rust_rss, report, rust_cpu = time_runout(args.runout)
-    rust_head = time_runout(args.runout, head)
-    base = time_runout(args.baseline) if args.baseline else None
-    base_head = time_runout(args.baseline, head) if args.baseline else None
-    pd_times, pd_rss = [], 0
-    for _ in range(args.repeats):
+    def runout_run(binary, file):
+        cmd = [binary, "identify", file, "--config", toml, "--json", "-"]
+        dt, out, rss = run_timed(cmd)
+        return dt, rss, json.loads(out), run_timed.cpu
+
+    def pandas_run():
         out = subprocess.run(
             [sys.executable, "-c", PANDAS_CHILD, path, str(skip)],
             check=True, capture_output=True, text=True,
         ).stdout.split()
-        pd_times.append(float(out[0]))
-        pd_rss = max(pd_rss, int(out[2]))
+        return float(out[0]), int(out[2]), None, None
+
+    jobs = {"rust": lambda: runout_run(args.runout, path),
+            "rust_head": lambda: runout_run(args.runout, head),
+            "pandas": pandas_run}
+    if args.baseline:
+        jobs["base"] = lambda: runout_run(args.baseline, path)
+        jobs["base_head"] = lambda: runout_run(args.baseline, head)
+    rng = random.Random(args.seed)
+    for _ in range(args.repeats):
+        order = list(jobs)
+        rng.shuffle(order)
+        for key in order:
+            runs.setdefault(key, []).append(jobs[key]())
+
+    def summary(key):
+        """(times, peak RSS, last report, median CPU) of one measurement over the rounds."""
+        r = runs[key]
+        cpu = [x[3] for x in r if x[3] is not None]
+        return ([x[0] for x in r], max(x[1] for x in r), r[-1][2],
+                statistics.median(cpu) if cpu else None)
+
+    rust, rust_rss, report, rust_cpu = summary("rust")
+    rust_head = summary("rust_head")
+    base = summary("base") if args.baseline else None
+    base_head = summary("base_head") if args.baseline else None
+    pd_times, pd_rss = summary("pandas")[:2]
     tr, tp = statistics.median(rust), statistics.median(pd_times)
     mb = size / 1e6
     print(f"file: {path}, {mb:.1f} MB; load average {open('/proc/loadavg').read().split()[:3]}")
@@ -187,7 +212,7 @@ def main():
         return (f"first {head_mb:.1f} MB alone {ts:.3f} s (CPU {small[3]:.3f} s, peak RSS "
                 f"{small[1] / 1024:.1f} MB): ingest rate without that fixed part {rate:.0f} MB/s")
 
-    print(f"runout identify (whole job, whole process, median of {len(rust)}): {tr:.3f} s = "
+    print(f"runout identify (whole job, whole process, median of {len(rust)} shuffled rounds): {tr:.3f} s = "
           f"{mb / tr:.0f} MB/s, CPU {rust_cpu:.3f} s, peak RSS {rust_rss / 1024:.1f} MB"
           f"{run_timed.rss_note}")
     print(f"  {ingest((rust, rust_rss, None, rust_cpu), rust_head)}")
@@ -203,7 +228,7 @@ def main():
         print(f"baseline {args.baseline} (same run): {tb:.3f} s = {mb / tb:.0f} MB/s, CPU {base[3]:.3f} s, "
               f"peak RSS {base[1] / 1024:.1f} MB; identical reports on one thread (provenance aside): {same}")
         print(f"  {ingest(base, base_head)}")
-    print(f"pandas {pd_version} read_csv + mean (median of {len(pd_times)}): {tp:.3f} s = "
+    print(f"pandas {pd_version} read_csv + mean (median of {len(pd_times)} shuffled rounds): {tp:.3f} s = "
           f"{mb / tp:.0f} MB/s, peak RSS {pd_rss / 1024:.1f} MB (whole interpreter)")
     print(f"ratio (wall): runout identify takes {tr / tp:.2f}× the pandas read "
           f"({'faster' if tr < tp else 'slower'})")
