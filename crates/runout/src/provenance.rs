@@ -22,7 +22,7 @@ use crate::job::Source;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
-use std::io::{Read, Seek};
+use std::io::Read;
 
 /// Where a report came from.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
@@ -133,9 +133,10 @@ impl InputFile {
 const STEP_BYTES: usize = 1 << 16;
 
 /// The SHA-256 of a list of inputs computed in steps of at most 64 KiB, so that the work can
-/// change threads: a clone is a checkpoint — the inputs done, the hash state and the position
-/// in the current input, not its open file, which the clone opens again and seeks to when it
-/// goes on. The CLI hashes on a background thread that runs only on otherwise idle cores, and
+/// change threads: a clone is a checkpoint — the inputs done, the hash state, the position in
+/// the current input and the current input's open file, shared (read at positions, not
+/// through a cursor), so that a checkpoint goes on with the file that was opened even when its
+/// name has since been removed or given to another file. The CLI hashes on a background thread that runs only on otherwise idle cores, and
 /// when the report is ready goes on from the latest checkpoint on its own thread rather than
 /// wait for the background one (which a busy machine may not schedule for long).
 ///
@@ -160,8 +161,8 @@ pub struct InputHashing {
     hasher: Sha256,
     /// Bytes of the current input hashed.
     offset: u64,
-    /// The current input, open at `offset` (not carried by a clone).
-    file: Option<std::fs::File>,
+    /// The current input, open (shared with the clones; read at `offset`).
+    file: Option<std::sync::Arc<std::fs::File>>,
     /// Read buffer (not carried by a clone).
     buf: Vec<u8>,
 }
@@ -173,7 +174,7 @@ impl Clone for InputHashing {
             done: self.done.clone(),
             hasher: self.hasher.clone(),
             offset: self.offset,
-            file: None,
+            file: self.file.clone(),
             buf: Vec::new(),
         }
     }
@@ -210,17 +211,15 @@ impl InputHashing {
             self.close_input(source, size);
             return Ok(self.is_done());
         };
-        if self.file.is_none() {
-            let mut f = std::fs::File::open(path).map_err(|e| named(source, e))?;
-            if self.offset > 0 {
-                f.seek(std::io::SeekFrom::Start(self.offset))
-                    .map_err(|e| named(source, e))?;
+        let file = match &self.file {
+            Some(f) => std::sync::Arc::clone(f),
+            None => {
+                let f = std::fs::File::open(path).map_err(|e| named(source, e))?;
+                self.file.insert(std::sync::Arc::new(f)).clone()
             }
-            self.file = Some(f);
-        }
+        };
         self.buf.resize(STEP_BYTES, 0);
-        let file = self.file.as_mut().expect("opened above");
-        let n = read_some(file, &mut self.buf, source)?;
+        let n = read_some_at(&file, &mut self.buf, self.offset, source)?;
         if n == 0 {
             self.close_input(source, self.offset);
         } else {
@@ -273,6 +272,30 @@ fn hash_in_memory(source: &Source, hasher: &mut Sha256) -> u64 {
 fn read_some(file: &mut std::fs::File, buf: &mut [u8], source: &Source) -> std::io::Result<usize> {
     loop {
         match file.read(buf) {
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            r => return r.map_err(|e| named(source, e)),
+        }
+    }
+}
+
+/// One read into `buf` at byte `offset` of `file`, whatever its cursor (positional: the clones
+/// of an [`InputHashing`] share the file); again when interrupted; errors name the source.
+fn read_some_at(
+    file: &std::fs::File,
+    buf: &mut [u8],
+    offset: u64,
+    source: &Source,
+) -> std::io::Result<usize> {
+    #[cfg(unix)]
+    use std::os::unix::fs::FileExt;
+    #[cfg(windows)]
+    use std::os::windows::fs::FileExt;
+    loop {
+        #[cfg(unix)]
+        let r = file.read_at(buf, offset);
+        #[cfg(windows)]
+        let r = file.seek_read(buf, offset);
+        match r {
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
             r => return r.map_err(|e| named(source, e)),
         }
@@ -399,6 +422,30 @@ mod tests {
         assert_eq!(steps, 11);
         assert!(hashing.is_done());
         assert_eq!(hashing.finish().unwrap(), expected);
+    }
+
+    /// A checkpoint goes on with the file that was open when it was taken: its name removed,
+    /// or given to a file of other content, does not change the hash (the clones share the
+    /// open file and read it at their own positions, in any order).
+    #[test]
+    fn a_checkpoint_hashes_the_file_that_was_opened() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("rec.txt");
+        let content: Vec<u8> = (0..3 * STEP_BYTES + 5).map(|k| (k % 241) as u8).collect();
+        std::fs::write(&p, &content).unwrap();
+        let expected = InputFile::of(&Source::bytes("rec.txt", content)).unwrap();
+        let mut hashing = InputHashing::new(vec![Source::path(&p)]);
+        hashing.step().unwrap();
+        let checkpoint = hashing.clone();
+        hashing.step().unwrap(); // the original reads on: the checkpoint's position is its own
+        std::fs::remove_file(&p).unwrap();
+        std::fs::write(&p, b"another file under the same name").unwrap();
+        let done = checkpoint.finish().unwrap();
+        assert_eq!(
+            (done[0].size_bytes, &done[0].sha256),
+            (expected.size_bytes, &expected.sha256)
+        );
+        assert_eq!(hashing.finish().unwrap()[0].sha256, expected.sha256);
     }
 
     /// An input that cannot be read stops the hashing with an error naming it, at every try.
