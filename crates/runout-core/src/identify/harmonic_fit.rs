@@ -28,8 +28,8 @@ use super::covariance::{fit_covariance, harmonic_groups};
 use super::error::IdentifyError;
 use super::frequency::frequency_estimate;
 use super::full_signal::{
-    candidate_runouts, compass_search, fit_summary, FitSummaryInput, FullSignalFit,
-    FullSignalOptions, RunoutObservability, NAMES, RUNOUT_STEP_UM,
+    candidate_runouts, compass_search, distinct_starts, fit_summary, FitSummaryInput,
+    FullSignalFit, FullSignalOptions, RunoutObservability, NAMES, RUNOUT_STEP_UM,
 };
 use super::model::{
     coefficient_gradient, grouping, join_grouped, BasisSums, GroupingScope, RevolutionModel, NB,
@@ -1403,8 +1403,8 @@ pub(crate) fn harmonic_fit(
     )> = None;
     // (the solves from the starts are independent: in parallel, compared in start order)
     let g = grouping();
-    let runs: Vec<_> = starts
-        .par_iter()
+    let runs: Vec<_> = distinct_starts(starts.iter().collect())
+        .into_par_iter()
         .with_max_len(1)
         .map(|(_, x)| {
             let _g = GroupingScope::new(g);
