@@ -219,7 +219,11 @@ fn per_recording(s: &Settings, key: &str, n: usize) -> Result<Vec<f64>, ConfigEr
         m => Err(ConfigError::Key {
             source_name: s.origin(key).unwrap_or("config").into(),
             key: key.into(),
-            message: format!("expected 1 value or {n} (one per recording), got {m}"),
+            message: if n == 1 {
+                format!("expected 1 value for the 1 recording given, got {m}")
+            } else {
+                format!("expected 1 value, or {n} (one per recording: {n} given), got {m}")
+            },
         }),
     }
 }
@@ -327,4 +331,35 @@ pub fn resolve_identify(s: &Settings, recordings: usize) -> Result<IdentifyCase,
         sensor_mode_hz,
         max_harmonic,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::{layer_from_toml, Settings};
+
+    /// A list of feeds that matches neither one value nor the recordings: the message names the
+    /// key, the file, how many values were expected for how many recordings, and how many came
+    /// (with one recording it once read "expected 1 value or 1 (one per recording)").
+    #[test]
+    fn a_list_of_the_wrong_length_names_what_was_expected() {
+        let toml =
+            "teeth = 4\ndiameter_mm = 10\nhelix_deg = 30\nrpm = 3240\nfz_mm = [0.05, 0.08]\n\
+                    ap_mm = 2\nae_mm = 2\nmode = \"down\"\n";
+        let mut s = Settings::new();
+        s.push(layer_from_toml("cut.toml", toml, &identify_key_names()).unwrap());
+        let one = resolve_identify(&s, 1).unwrap_err().to_string();
+        assert!(
+            one.contains("cut.toml")
+                && one.contains("fz_mm")
+                && one.ends_with("expected 1 value for the 1 recording given, got 2"),
+            "{one}"
+        );
+        let three = resolve_identify(&s, 3).unwrap_err().to_string();
+        assert!(
+            three.ends_with("expected 1 value, or 3 (one per recording: 3 given), got 2"),
+            "{three}"
+        );
+        assert!(resolve_identify(&s, 2).is_ok());
+    }
 }
