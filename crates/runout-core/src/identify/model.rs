@@ -551,13 +551,18 @@ where
 }
 
 /// Disk blocks × grid samples from which [`split_sum`] runs the halves in parallel. The fits
-/// use the second core at a coarser grain (trial points, grid candidates and difference
-/// columns costed in parallel: `full_signal`, `harmonic_fit`, `alignment`); at their sizes
-/// (e.g. 133 disks × 185 or 740 samples, 0.1–1 ms per compute) splitting one compute across
-/// the threads cost more than it saved (waking the pool's threads from the serial steps:
-/// 2 threads were slower than 1 on the `identify` bench head job, about a quarter of the fits'
-/// CPU in futex and scheduler calls). Only a very large model is still split in parallel.
-const PARALLEL_WORK: usize = 1 << 20;
+/// also use the second core at a coarser grain (trial points, grid candidates and difference
+/// columns costed in parallel: `full_signal`, `harmonic_fit`, `alignment`). When each compute
+/// was handed to the pool from the calling thread, splitting one (e.g. 133 disks × 185 or 740
+/// samples, 0.1–1 ms) cost more than it saved: waking the pool's threads from the serial steps
+/// (2 threads slower than 1 on the `identify` bench head job, about a quarter of the fits' CPU
+/// in futex and scheduler calls), and the threshold was 2²⁰. Since the fits run as one task on
+/// the pool ([`on_pool`]), a split is taken by a thread of the same pool: with 2¹⁴ (every
+/// model of the fits but stage 1's coarse one) the 1 MB head job took 0.200 → 0.190,
+/// 0.196 → 0.188 and 0.177 → 0.173 s in three shuffled A/Bs of 21–31 rounds (2¹³, which
+/// splits the coarse model too: 0.175 s), reports bit-identical (the halves are the same,
+/// [`split_sum`]); on the 100 MB job within the noise (0.444 / 0.447 s).
+const PARALLEL_WORK: usize = 1 << 14;
 
 /// `run` over `disks`, split in halves (at len/2) and summed left + right, with the decisions
 /// of rayon's adaptive splitter (`splits` starts at the pool's thread count and halves per
