@@ -517,7 +517,8 @@ impl Drop for GroupingScope {
 /// sections of the fits inside it are nested in the pool (work stealing between its threads)
 /// instead of each being handed to the pool from outside and waited for (issue 18: each such
 /// hand-off wakes a sleeping thread, ≈ 0.1–0.2 ms on a virtual machine). The sums keep the
-/// grouping of the caller ([`grouping`]), so the results are the same bit for bit as when `f`
+/// grouping of the caller (whether it runs outside the pool: the disk sums are grouped as
+/// there), so the results are the same bit for bit as when `f`
 /// runs on the calling thread. On a thread of the pool, `f` simply runs.
 ///
 /// ```

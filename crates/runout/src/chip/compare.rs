@@ -18,7 +18,7 @@ use std::time::Instant;
 /// `runout chip compare`.
 #[derive(Debug, Clone)]
 pub struct CompareRequest {
-    /// Case-set file (TOML: [defaults] and [[case]] tables).
+    /// Case-set file (TOML: `[defaults]` and `[[case]]` tables).
     pub config: Source,
     /// Only the cases whose name contains this text.
     pub case: Option<String>,

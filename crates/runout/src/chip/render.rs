@@ -101,7 +101,7 @@ pub fn eval_text(r: &EvalReport) -> String {
     s
 }
 
-/// The h CSV: time_s, spindle_angle_deg, tooth, z_mm, h_<model>_mm.
+/// The h CSV: `time_s, spindle_angle_deg, tooth, z_mm, h_<model>_mm`.
 pub fn eval_csv(mut w: impl std::io::Write, r: &EvalReport) -> Result<()> {
     let case = case_of(r)?;
     writeln!(w, "time_s,spindle_angle_deg,tooth,z_mm,h_{}_mm", r.model)?;

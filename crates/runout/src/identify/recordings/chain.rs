@@ -377,7 +377,7 @@ pub struct RecordingRunout {
     pub angle_deg: f64,
     pub angle_deg_se: Option<f64>,
     pub r_squared: f64,
-    /// True when it disagrees with the joint fit (see [`consistency`]).
+    /// True when it disagrees with the joint fit (see `consistency`).
     pub disagrees: bool,
 }
 
