@@ -44,6 +44,16 @@ struct Shared {
     stop: AtomicBool,
 }
 
+impl Shared {
+    /// Put `value` in `latest`; the value it held (the lock is held for the swap only).
+    fn swap(&self, value: Result<InputHashing, String>) -> Result<InputHashing, String> {
+        std::mem::replace(
+            &mut *self.latest.lock().unwrap_or_else(|e| e.into_inner()),
+            value,
+        )
+    }
+}
+
 /// What the hashing thread ended with.
 #[derive(Debug)]
 enum Outcome {
@@ -78,13 +88,8 @@ pub fn start(args: Vec<String>) {
 /// [`CHECKPOINT_STEPS`] steps, the finished hashing at the end or the error that stopped it;
 /// returns early once the finishing thread has taken over.
 fn hash_in_background(mut hashing: InputHashing, shared: &Shared) {
-    let publish = |value: Result<InputHashing, String>| {
-        let old = std::mem::replace(
-            &mut *shared.latest.lock().unwrap_or_else(|e| e.into_inner()),
-            value,
-        );
-        drop(old); // outside the lock
-    };
+    // (the value replaced is dropped here, outside the lock)
+    let publish = |value: Result<InputHashing, String>| drop(shared.swap(value));
     let mut steps = 0u64;
     while !shared.stop.load(Ordering::Relaxed) {
         match hashing.step() {
@@ -104,14 +109,7 @@ fn hash_in_background(mut hashing: InputHashing, shared: &Shared) {
 /// from the latest checkpoint (at once when the background thread has finished it).
 fn settle(pending: Pending) -> Outcome {
     pending.shared.stop.store(true, Ordering::Relaxed);
-    let latest = std::mem::replace(
-        &mut *pending
-            .shared
-            .latest
-            .lock()
-            .unwrap_or_else(|e| e.into_inner()),
-        Err(String::new()),
-    );
+    let latest = pending.shared.swap(Err(String::new()));
     match latest.and_then(|h| h.finish().map_err(|e| e.to_string())) {
         Ok(inputs) => Outcome::Done(Provenance::of_inputs(pending.args, inputs)),
         Err(why) => Outcome::Failed(why),

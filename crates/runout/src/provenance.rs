@@ -22,7 +22,6 @@ use crate::job::Source;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
-use std::io::Read;
 
 /// Where a report came from.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
@@ -97,27 +96,11 @@ impl Provenance {
 }
 
 impl InputFile {
-    /// Name, size and SHA-256 of one source.
+    /// Name, size and SHA-256 of one source (files are streamed: memory does not grow with
+    /// their size).
     pub fn of(source: &Source) -> std::io::Result<Self> {
-        let mut hasher = Sha256::new();
-        let size_bytes = match source.as_path() {
-            Some(path) => {
-                let mut file = std::fs::File::open(path).map_err(|e| named(source, e))?;
-                let mut buf = vec![0u8; STEP_BYTES];
-                let mut total = 0u64;
-                loop {
-                    let n = read_some(&mut file, &mut buf, source)?;
-                    if n == 0 {
-                        break;
-                    }
-                    hasher.update(&buf[..n]);
-                    total += n as u64;
-                }
-                total
-            }
-            None => hash_in_memory(source, &mut hasher),
-        };
-        Ok(Self::finished(source, size_bytes, hasher))
+        let mut done = InputHashing::new(vec![source.clone()]).finish()?;
+        Ok(done.pop().expect("one input hashed"))
     }
 
     fn finished(source: &Source, size_bytes: u64, hasher: Sha256) -> Self {
@@ -134,11 +117,12 @@ const STEP_BYTES: usize = 1 << 16;
 
 /// The SHA-256 of a list of inputs computed in steps of at most 64 KiB, so that the work can
 /// change threads: a clone is a checkpoint — the inputs done, the hash state, the position in
-/// the current input and the current input's open file, shared (read at positions, not
-/// through a cursor), so that a checkpoint goes on with the file that was opened even when its
-/// name has since been removed or given to another file. The CLI hashes on a background thread that runs only on otherwise idle cores, and
-/// when the report is ready goes on from the latest checkpoint on its own thread rather than
-/// wait for the background one (which a busy machine may not schedule for long).
+/// the current input and the current input's open file, shared (read at positions, not through
+/// a cursor), so that a checkpoint goes on with the file that was opened even when its name has
+/// since been removed or given to another file. The CLI hashes on a background thread that runs
+/// only on otherwise idle cores and, when the report is ready, goes on from the latest
+/// checkpoint on its own thread rather than wait for the background one (which a busy machine
+/// may not schedule for long).
 ///
 /// ```
 /// use runout::provenance::{InputFile, InputHashing};
@@ -264,16 +248,6 @@ fn hash_in_memory(source: &Source, hasher: &mut Sha256) -> u64 {
             let bytes = source.as_bytes().unwrap_or_default();
             hasher.update(bytes);
             bytes.len() as u64
-        }
-    }
-}
-
-/// One read into `buf` (again when interrupted); errors name the source.
-fn read_some(file: &mut std::fs::File, buf: &mut [u8], source: &Source) -> std::io::Result<usize> {
-    loop {
-        match file.read(buf) {
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            r => return r.map_err(|e| named(source, e)),
         }
     }
 }
