@@ -88,7 +88,10 @@ pub type ChunkSink<'s> = dyn FnMut(SignalChunk<'_>) -> Result<(), SignalError> +
 
 /// Run the three passes over a source that can be replayed: `replay(sink)` must feed the whole
 /// recording, in order, chunk by chunk, into `sink` (e.g. by re-reading a file). It is called
-/// three times. Errors of the source (type `E`) pass through.
+/// three times, and must deliver the same samples each time: pass 1 checks every value finite,
+/// passes 2 and 3 check each chunk's lengths and channel set, their number of samples and that
+/// their results are finite (a replay that breaks this is an error, never a silently wrong
+/// average). Errors of the source (type `E`) pass through.
 pub fn analyse_replay<E, R>(cfg: &SignalConfig, mut replay: R) -> Result<SignalAnalysis, E>
 where
     E: From<SignalError>,
@@ -97,12 +100,34 @@ where
     let mut scan = SpindleScan::new(cfg)?;
     replay(&mut |c| scan.push(c))?;
     let scan = scan.finish()?;
-    let mut tracker = PhaseTracker::new(cfg, &scan)?;
+    // passes 2 and 3 see the values pass 1 checked finite: they check lengths and the channel
+    // set of each chunk, the number of samples at the end, and that their results are finite
+    let mut tracker = PhaseTracker::new(cfg, &scan)?.replaying();
     replay(&mut |c| tracker.push(c))?;
+    same_recording(2, tracker.samples(), scan.samples)?;
     let speed = tracker.finish()?;
-    let mut avg = SyncAverager::new(cfg, &scan, &speed)?;
+    let mut avg = SyncAverager::new(cfg, &scan, &speed)?.replaying();
     replay(&mut |c| avg.push(c))?;
+    same_recording(3, avg.samples(), scan.samples)?;
     let average = avg.finish()?;
+    let finite = speed.rpm.is_finite()
+        && speed
+            .angle_wander
+            .iter()
+            .all(|(t, w)| t.is_finite() && w.is_finite())
+        && average
+            .components
+            .iter()
+            .all(|c| c.mean.iter().all(|m| m.is_finite()));
+    if !finite {
+        return Err(SignalError::Channels {
+            sample: 0,
+            what: "a replay delivered values that are not finite where pass 1 saw none: the replay must \
+                   deliver the recording of pass 1"
+                .into(),
+        }
+        .into());
+    }
     let mut warnings: Vec<String> = speed.warning().into_iter().collect();
     if speed.method == SpeedMethod::Spectrum {
         warnings.push(format!(
@@ -139,6 +164,20 @@ where
         speed,
         average,
         warnings,
+    })
+}
+
+/// The error for a replay (pass `pass`) that delivered `got` samples where pass 1 saw `want`.
+fn same_recording(pass: u8, got: u64, want: u64) -> Result<(), SignalError> {
+    if got == want {
+        return Ok(());
+    }
+    Err(SignalError::Channels {
+        sample: got.min(want),
+        what: format!(
+            "the replay of pass {pass} delivered {got} samples where pass 1 saw {want}: the replay \
+             must deliver the recording of pass 1"
+        ),
     })
 }
 

@@ -223,6 +223,18 @@ impl PhaseTracker {
         })
     }
 
+    /// The same pass over a replay whose values pass 1 has checked finite
+    /// ([`super::analyse_replay`]): each chunk's lengths and channel set are still checked.
+    pub(crate) fn replaying(mut self) -> Self {
+        self.guard = ChunkGuard::values_checked();
+        self
+    }
+
+    /// Samples fed so far.
+    pub(crate) fn samples(&self) -> u64 {
+        self.guard.next
+    }
+
     /// Feed the next chunk.
     pub fn push(&mut self, c: SignalChunk) -> Result<(), SignalError> {
         let start = self.guard.next;

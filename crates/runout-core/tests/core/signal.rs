@@ -775,6 +775,60 @@ fn non_finite_samples_and_ragged_channels_are_errors() {
     assert!(e.to_string().contains("channel set changed"), "{e}");
 }
 
+/// Passes 2 and 3 trust pass 1's finiteness check (issue 18), so a replay that breaks its
+/// contract — other values or another length than pass 1 saw — must still end in an error, never
+/// in an average: a NaN in pass 2 or pass 3, and a replay one sample short. The same
+/// replay without the fault gives the analysis of the samples in memory.
+#[test]
+fn a_replay_that_differs_from_pass_1_is_an_error() {
+    let (fx, fy, fz) = phm();
+    let cfg = phm_config();
+    let whole = analyse(&cfg, SignalChunk::xyz(&fx, &fy, &fz)).unwrap();
+    let mid = fx.len() / 2;
+    let run = |bad_pass: usize, at: usize, short: bool| {
+        let mut pass = 0;
+        analyse_replay::<SignalError, _>(&cfg, |sink| {
+            pass += 1;
+            let mut x = fx.clone();
+            if pass == bad_pass {
+                x[at] = f64::NAN;
+            }
+            let n = if short && pass == bad_pass {
+                x.len() - 1
+            } else {
+                x.len()
+            };
+            sink(SignalChunk::xyz(&x[..n], &fy[..n], &fz[..n]))
+        })
+    };
+    // pass 2: the tracker's speed comes out NaN, which it reports itself
+    let e = run(2, mid, false).unwrap_err();
+    assert!(e.to_string().contains("NaN"), "{e}");
+    let e = run(3, mid, false).unwrap_err();
+    assert!(
+        e.to_string().contains("not finite where pass 1 saw none"),
+        "{e}"
+    );
+    for pass in [2, 3] {
+        let e = run(pass, 0, true).unwrap_err();
+        assert!(
+            e.to_string().contains(&format!(
+                "the replay of pass {pass} delivered {} samples where pass 1 saw {}",
+                fx.len() - 1,
+                fx.len()
+            )),
+            "pass {pass}: {e}"
+        );
+    }
+    assert_eq!(run(0, mid, false).unwrap(), whole);
+    // pass 1 still names the sample
+    let e = run(1, mid, false).unwrap_err();
+    assert!(
+        matches!(e, SignalError::NonFinite { sample, .. } if sample == mid as u64),
+        "{e}"
+    );
+}
+
 #[test]
 fn noise_air_cut_and_broken_pulse_are_errors() {
     let mut rng = StdRng::seed_from_u64(9);
