@@ -90,6 +90,11 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
 
 fn main() -> ExitCode {
     quiet_on_broken_pipe();
+    // SAFETY: text recordings are mapped instead of read (issue 18: one copy of the file less);
+    // a recording shortened while it is read is reported as an error by the reader's SIGBUS
+    // guard. One rewritten in place while it is read would be a mixed file either way, as a
+    // read of it would be.
+    unsafe { runout_io::mapped::allow_mapped_files() };
     let cli = Cli::parse();
     progress::set_quiet(cli.quiet);
     // the program by its name, not the path it was started from (the same on every machine)

@@ -15,6 +15,7 @@ pub mod gcode;
 pub mod grind;
 pub mod lineplot;
 mod located;
+pub mod mapped;
 pub mod peak_table;
 pub mod plot;
 pub mod recording;

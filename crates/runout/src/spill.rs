@@ -4,7 +4,12 @@
 //!
 //! Layout, per block: u64 LE row count, then each channel's values as f64 LE. The file is
 //! deleted when the [`Spill`] is dropped (also on errors).
+//!
+//! Read back either through a [`SpillReader`] (the blocks copied into a chunk's columns) or,
+//! when the process allows mapped files (`runout_io::mapped`), as [`MappedSpill`] blocks whose
+//! columns are the file's pages themselves (issue 18: no copy).
 
+use runout_io::mapped::MappedFile;
 use runout_io::recording::RecordingChunk;
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Read, Write};
@@ -82,6 +87,24 @@ impl Spill {
         Ok(())
     }
 
+    /// Finish writing and map the blocks (`None` when the process does not allow mapped files,
+    /// the spill is empty, or on a big-endian machine: then [`Spill::reader`]).
+    pub fn mapped(&mut self) -> io::Result<Option<MappedSpill>> {
+        if let Some(mut w) = self.writer.take() {
+            w.flush()?;
+        }
+        if cfg!(target_endian = "big") {
+            return Ok(None);
+        }
+        let map = MappedFile::new(File::open(&self.path)?, 0);
+        Ok(map.map(|map| MappedSpill {
+            map,
+            channels: self.channels,
+            pos: 0,
+            read: 0,
+        }))
+    }
+
     /// Finish writing and read the blocks back from the start.
     pub fn reader(&mut self) -> io::Result<SpillReader> {
         if let Some(mut w) = self.writer.take() {
@@ -148,6 +171,65 @@ impl SpillReader {
     }
 }
 
+/// A [`Spill`]'s blocks in a mapped file: each block's columns borrowed from the map.
+pub struct MappedSpill {
+    map: MappedFile,
+    channels: usize,
+    /// Where the next block starts (bytes).
+    pos: usize,
+    /// Bytes of the blocks handed out so far (released at the next block).
+    read: usize,
+}
+
+impl MappedSpill {
+    /// The next block's columns (each the block's rows long), or `None` at the end; the block
+    /// before is released from the process's memory (`MappedFile::release`). An error when the
+    /// file does not hold the block its row count announces.
+    pub fn next_block(&mut self) -> io::Result<Option<Vec<&[f64]>>> {
+        self.map.release(0, self.read);
+        let bytes = self.map.bytes();
+        let Some(head) = bytes.get(self.pos..self.pos + 8) else {
+            return if self.pos == bytes.len() {
+                Ok(None)
+            } else {
+                Err(truncated(self.pos))
+            };
+        };
+        let n = u64::from_le_bytes(head.try_into().expect("8 bytes"));
+        let width = usize::try_from(n)
+            .ok()
+            .and_then(|n| n.checked_mul(8))
+            .ok_or_else(|| truncated(self.pos))?;
+        let start = self.pos + 8;
+        let end = width
+            .checked_mul(self.channels)
+            .and_then(|b| b.checked_add(start))
+            .filter(|&e| e <= bytes.len())
+            .ok_or_else(|| truncated(self.pos))?;
+        let columns = (0..self.channels)
+            .map(|k| {
+                let b = &bytes[start + k * width..start + (k + 1) * width];
+                bytemuck::try_cast_slice(b).map_err(|e| io::Error::other(e.to_string()))
+            })
+            .collect::<io::Result<Vec<&[f64]>>>()?;
+        self.pos = end;
+        self.read = end;
+        Ok(Some(columns))
+    }
+
+    /// The end of the reading: an error if the file was shortened meanwhile.
+    pub fn finish(self) -> io::Result<()> {
+        self.map.shortened().map_or(Ok(()), Err)
+    }
+}
+
+fn truncated(at: usize) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::InvalidData,
+        format!("the block at byte {at} is cut short"),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -178,5 +260,79 @@ mod tests {
         assert!(path.exists());
         drop(s);
         assert!(!path.exists());
+    }
+
+    /// Mapped, the blocks are the same bits as read (issue 18); a file cut inside a block is an
+    /// error, not a shorter block.
+    #[test]
+    fn mapped_blocks_are_the_blocks_read() {
+        // SAFETY: the test's files are not written in place while they are read
+        unsafe { runout_io::mapped::allow_mapped_files() };
+        let path = Spill::temp_path("test-mapped");
+        let mut s = Spill::create(path.clone(), 2).unwrap();
+        let mut c = RecordingChunk::default();
+        for n in [3usize, 5, 65_536, 1] {
+            c.time_s = vec![0.0; n];
+            c.values = vec![
+                (0..n).map(|i| i as f64 * 0.1 - 7.0).collect(),
+                (0..n)
+                    .map(|i| if i == 1 { f64::NAN } else { -(i as f64) })
+                    .collect(),
+            ];
+            s.write(&c).unwrap();
+        }
+        let mut read = Vec::new();
+        let mut r = s.reader().unwrap();
+        let mut back = RecordingChunk::default();
+        while r.read_chunk(&mut back).unwrap() > 0 {
+            read.push(
+                back.values
+                    .iter()
+                    .map(|v| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>())
+                    .collect::<Vec<_>>(),
+            );
+        }
+        assert_eq!(read.len(), 4);
+        let mapped_here = s.mapped().unwrap();
+        // mapped files are allowed on Linux only
+        assert_eq!(mapped_here.is_some(), cfg!(target_os = "linux"));
+        let Some(mut m) = mapped_here else { return };
+        let mut mapped = Vec::new();
+        while let Some(cols) = m.next_block().unwrap() {
+            mapped.push(
+                cols.iter()
+                    .map(|v| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>())
+                    .collect::<Vec<_>>(),
+            );
+        }
+        assert_eq!(mapped, read);
+        m.finish().unwrap();
+        // cut inside the last block
+        let len = std::fs::metadata(&path).unwrap().len();
+        let copy = Spill::temp_path("test-cut");
+        std::fs::copy(&path, &copy).unwrap();
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(&copy)
+            .unwrap()
+            .set_len(len - 4)
+            .unwrap();
+        let mut m = MappedSpill {
+            map: MappedFile::new(File::open(&copy).unwrap(), 0).unwrap(),
+            channels: 2,
+            pos: 0,
+            read: 0,
+        };
+        let mut blocks = 0;
+        let e = loop {
+            match m.next_block() {
+                Ok(Some(_)) => blocks += 1,
+                Ok(None) => panic!("a cut block read as whole"),
+                Err(e) => break e,
+            }
+        };
+        assert_eq!(blocks, 3);
+        assert!(e.to_string().contains("cut short"), "{e}");
+        std::fs::remove_file(&copy).unwrap();
     }
 }

@@ -243,6 +243,12 @@ pub struct RecordingReader<R> {
     /// Table mode ([`RecordingReader::table_from_reader`]): the line number of each row of the
     /// last chunk.
     row_lines: Option<Vec<u64>>,
+    /// The file a text recording was opened from, when the process allows its data rows to be
+    /// mapped instead of read ([`crate::mapped::allow_mapped_files`]; used by the parallel
+    /// parse).
+    mappable: Option<File>,
+    /// Whether the data rows were parsed from a mapping (for tests).
+    data_mapped: bool,
 }
 
 impl<R: BufRead + Send + 'static> RecordingReader<R> {
@@ -280,6 +286,8 @@ impl<R: BufRead + Send + 'static> RecordingReader<R> {
             finished: self.finished,
             binary: self.binary,
             row_lines: self.row_lines,
+            mappable: self.mappable,
+            data_mapped: self.data_mapped,
         }
     }
 }
@@ -293,8 +301,14 @@ impl RecordingReader<BufReader<File>> {
             file: file.clone(),
             error,
         })?;
+        let mappable = if crate::mapped::allowed() {
+            f.try_clone().ok()
+        } else {
+            None
+        };
         let mut r = Self::from_reader(BufReader::with_capacity(1 << 16, f), &file, options)?;
         r.info.file_bytes = std::fs::metadata(path).ok().map(|m| m.len());
+        r.mappable = mappable;
         Ok(r)
     }
 }
@@ -540,6 +554,8 @@ impl<R: BufRead> RecordingReader<R> {
             finished: false,
             binary: None,
             row_lines: table.then(Vec::new),
+            mappable: None,
+            data_mapped: false,
         })
     }
 
@@ -569,6 +585,8 @@ impl<R: BufRead> RecordingReader<R> {
             finished: false,
             binary: Some(Box::new(rec)),
             row_lines: None,
+            mappable: None,
+            data_mapped: false,
         }
     }
 
@@ -1572,6 +1590,42 @@ mod tests {
         (out, error, r.bytes_read(), r.warnings().to_vec())
     }
 
+    /// What a reading gave: chunks, first error, bytes read, warnings.
+    type Outcome = (Vec<Bits>, Option<String>, u64, Vec<String>);
+
+    /// [`parallel_in_jobs_of`] over `bytes` written to a file and mapped (`mapped` module):
+    /// the name in messages is the file's path. Asserts that the data rows were mapped (unless
+    /// the rows read ahead at open hold an error).
+    fn mapped_in_jobs_of(
+        bytes: &[u8],
+        job_bytes: usize,
+        rows: usize,
+        workers: usize,
+    ) -> (Outcome, String) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.csv");
+        std::fs::write(&path, bytes).unwrap();
+        let name = path.display().to_string();
+        // SAFETY: test files are not written while they are read
+        unsafe { crate::mapped::allow_mapped_files() };
+        let mut r = RecordingReader::open(&path, &ReadOptions::new()).unwrap();
+        let mut c = RecordingChunk::default();
+        let mut out = Vec::new();
+        let error = r
+            .for_each_chunk_in_jobs_of(job_bytes, &mut c, rows, workers, |c, _, _| {
+                out.push(bits(c));
+                true
+            })
+            .err()
+            .map(|e| e.to_string());
+        // (an error in the rows read ahead at open comes before any mapping)
+        assert!(
+            r.data_mapped || error.is_some(),
+            "the rows were read, not mapped"
+        );
+        ((out, error, r.bytes_read(), r.warnings().to_vec()), name)
+    }
+
     /// Line `form` of the forms the common-row path must either take (signs, `.5`, `5.`,
     /// `-0.000`, a long fraction) or hand back to the full path (exponents, blanks, quotes, a
     /// lone `\r`, fields missing or extra, long mantissas, text, times off), for the row of
@@ -1629,12 +1683,104 @@ mod tests {
             proptest::prop_assert_eq!(got.2, want.2, "bytes read");
             proptest::prop_assert_eq!(&got.3, &want.3);
             proptest::prop_assert!(got.0 == want.0, "chunks");
+            // the same lines from a mapped file (its path in the messages)
+            let (got, name) = mapped_in_jobs_of(bytes, job_bytes, 97, 2);
+            let want = serial(RecordingReader::from_bytes(&name, bytes, &opts).unwrap(), 97);
+            proptest::prop_assert_eq!(&got.1, &want.1);
+            proptest::prop_assert_eq!(got.2, want.2, "bytes read (mapped)");
+            proptest::prop_assert!(got.0 == want.0, "chunks (mapped)");
         }
     }
 
     /// Parsing on 2 and 3 threads gives the chunks of `read_chunk` bit for bit (same sizes,
     /// first samples, times, values), the same bytes read and the same end-of-data warning, at
     /// chunk sizes below and above the job size and across input blocks cut anywhere.
+    /// A file mapped instead of read (issue 18, `mapped` module) gives `read_chunk`'s chunks,
+    /// bytes read and warnings bit for bit: mixed line ends, blank lines and no final line
+    /// end (the `text` fixture), behind a DynoWare header and a UTF-8 byte-order mark, in jobs
+    /// of the default size and of a few bytes, on 2 and 3 workers.
+    #[test]
+    fn mapped_files_parse_as_read_files() {
+        let (bytes, _) = text();
+        let opts = ReadOptions::new();
+        let mut dyno = b"\xEF\xBB\xBFDynoWare,Version 2.5\nSampling rate [Hz]:,10000\nSamples per channel:,5\n".to_vec();
+        dyno.extend_from_slice(&bytes);
+        for src in [&bytes, &dyno] {
+            for (job_bytes, workers) in [(1 << 20, 2), (1 << 20, 3), (97, 2)] {
+                let (got, name) = mapped_in_jobs_of(src, job_bytes, 65_536, workers);
+                let want = serial(
+                    RecordingReader::from_bytes(&name, src, &opts).unwrap(),
+                    65_536,
+                );
+                assert!(want.1.is_none());
+                assert!(got == want, "jobs of {job_bytes} bytes, {workers} workers");
+            }
+        }
+    }
+
+    /// A mapped file shortened while its rows are parsed (issue 18): the pages past its new end
+    /// fault (SIGBUS), the guard puts zeros there, and the reading ends in an error naming the
+    /// file as shortened — no panic, no crash, and no chunk past the rows before the cut. The
+    /// same file read whole gives every row.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_mapped_file_shortened_while_read_is_an_error() {
+        let mut text = String::from("time_s,a_N,b_N\n");
+        for k in 0..800_000u32 {
+            text += &format!(
+                "{:.5},{:.4},-{}.5\n",
+                f64::from(k) / 1e5,
+                f64::from(k) * 0.37,
+                k % 91
+            );
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("growing.csv");
+        std::fs::write(&path, &text).unwrap();
+        // SAFETY: the file is shortened (not written in place) while it is read
+        unsafe { crate::mapped::allow_mapped_files() };
+        let mut r = RecordingReader::open(&path, &ReadOptions::new()).unwrap();
+        let mut c = RecordingChunk::default();
+        let mut rows = 0;
+        let cut = 1_000_000u64;
+        let e = r
+            .for_each_chunk(&mut c, 4096, 2, |c, n, _| {
+                if rows == 0 {
+                    std::fs::OpenOptions::new()
+                        .write(true)
+                        .open(&path)
+                        .unwrap()
+                        .set_len(cut)
+                        .unwrap();
+                }
+                rows += n;
+                assert!(c.time_s.iter().all(|t| t.is_finite()));
+                true
+            })
+            .unwrap_err()
+            .to_string();
+        assert!(r.data_mapped);
+        assert!(
+            e.contains("growing.csv")
+                && e.contains(&format!(
+                    "shortened while it was being read ({} bytes when opened, {cut} now)",
+                    text.len()
+                )),
+            "{e}"
+        );
+        // fewer rows than the file had (the parse stopped at the zeros or at the error)
+        assert!(rows < 800_000, "{rows} rows");
+        std::fs::write(&path, &text).unwrap();
+        let mut r = RecordingReader::open(&path, &ReadOptions::new()).unwrap();
+        let mut rows = 0;
+        r.for_each_chunk(&mut c, 4096, 2, |_, n, _| {
+            rows += n;
+            true
+        })
+        .unwrap();
+        assert_eq!(rows, 800_000);
+    }
+
     #[test]
     fn parallel_parsing_equals_serial() {
         let (bytes, _) = text();
@@ -1722,6 +1868,17 @@ mod tests {
                     "chunks before the error at line {}",
                     at + 1
                 );
+            }
+            // from a mapped file, in jobs of the default size and small ones
+            for job_bytes in [1 << 20, 4099] {
+                let (got, name) = mapped_in_jobs_of(&src, job_bytes, 4096, 2);
+                let want = serial(
+                    RecordingReader::from_bytes(&name, &src, &opts).unwrap(),
+                    4096,
+                );
+                assert_eq!(got.1, want.1, "mapped, line {}", at + 1);
+                assert_eq!(got.2, want.2, "mapped, bytes read at line {}", at + 1);
+                assert!(got.0 == want.0, "mapped, chunks before line {}", at + 1);
             }
         }
         // a read error after 3 MB: the rows before it, then the error

@@ -14,6 +14,7 @@ use super::{
     checked_time, long_line, trim_field, RecordingChunk, RecordingError, RecordingReader, Result,
     RowParser, Slot, MAX_LINE_BYTES,
 };
+use crate::mapped::MappedFile;
 use std::io::{BufRead, Read};
 use std::sync::mpsc;
 
@@ -32,6 +33,8 @@ enum Job {
     Lines(Vec<u8>, usize),
     /// The input could not be read after the lines of the jobs before.
     Io(std::io::Error),
+    /// Whole lines of a mapped input: `map[start..end]`.
+    Span(usize, usize),
 }
 
 /// What a worker made of a job.
@@ -57,6 +60,8 @@ struct Parsed {
     /// The job's text, kept until the rows are taken (a time error's position in bytes is
     /// found in it), then handed back to the splitter.
     text: Vec<u8>,
+    /// A mapped job's bytes in the map (its `text` is then empty).
+    span: Option<(usize, usize)>,
 }
 
 impl Parsed {
@@ -70,14 +75,18 @@ impl Parsed {
         self.bytes = 0;
         self.error = None;
         self.error_bytes = 0;
+        self.span = None;
     }
 
     /// Bytes of the job's text through its first `lines` lines, endings included.
-    fn bytes_through(&self, lines: u64) -> u64 {
+    fn bytes_through(&self, map: &[u8], lines: u64) -> u64 {
         if lines == 0 {
             return 0;
         }
-        let text = &self.text[..self.bytes as usize];
+        let text = match self.span {
+            Some((a, b)) => &map[a..b],
+            None => &self.text[..self.bytes as usize],
+        };
         memchr::memchr_iter(b'\n', text)
             .nth(lines as usize - 1)
             .map_or(text.len(), |k| k + 1) as u64
@@ -249,6 +258,36 @@ fn split<R: Read>(
     }
 }
 
+/// Cut a mapped input into jobs of whole lines, as [`split`] cuts a read one: about
+/// `job_bytes` each, cut after the last line end in them, or after the first one past them; a
+/// line with no end within [`MAX_LINE_BYTES`] is sent alone, for its worker to report, and ends
+/// the cutting. Job `k` goes to `jobs[k mod W]`; ends early when a worker has stopped.
+fn split_map(map: &[u8], job_bytes: usize, jobs: Vec<mpsc::SyncSender<Job>>) {
+    let w = jobs.len();
+    let mut pos = 0;
+    for k in 0.. {
+        if pos >= map.len() {
+            return;
+        }
+        let want = pos.saturating_add(job_bytes).min(map.len());
+        let (end, last) = if want == map.len() {
+            (want, false)
+        } else if let Some(p) = memchr::memrchr(b'\n', &map[pos..want]) {
+            (pos + p + 1, false)
+        } else {
+            let limit = (pos + MAX_LINE_BYTES as usize + 1).min(map.len()).max(want);
+            match memchr::memchr(b'\n', &map[want..limit]) {
+                Some(p) => (want + p + 1, false),
+                None => (limit, limit < map.len()),
+            }
+        };
+        if jobs[k % w].send(Job::Span(pos, end)).is_err() || last {
+            return;
+        }
+        pos = end;
+    }
+}
+
 /// Bytes asked of the input per read.
 const READ_BYTES: usize = 1 << 16;
 
@@ -331,6 +370,15 @@ impl<R: BufRead + Send> RecordingReader<R> {
             chunk.values.resize_with(channels, Vec::new);
             chunk.values.iter_mut().for_each(Vec::clear);
         };
+        // the rest of a file mapped, when the process allows it (`crate::mapped`), from the
+        // first byte not parsed yet: the bytes the reader holds must be the map's first ones
+        let mapped = self
+            .mappable
+            .take()
+            .and_then(|f| MappedFile::new(f, bytes))
+            .filter(|m| m.bytes().starts_with(&carry));
+        let map: &[u8] = mapped.as_ref().map_or(&[], |m| m.bytes());
+        self.data_mapped = mapped.is_some();
         let ended = std::thread::scope(|scope| -> Result<bool> {
             let mut job_tx = Vec::new();
             let mut res_rx = Vec::new();
@@ -350,6 +398,10 @@ impl<R: BufRead + Send> RecordingReader<R> {
                                 parse_job(&parser, has_time, &b[..n], &mut out);
                                 out.text = b;
                             }
+                            Job::Span(a, b) => {
+                                parse_job(&parser, has_time, &map[a..b], &mut out);
+                                out.span = Some((a, b));
+                            }
                             Job::Io(error) => {
                                 out.error = Some(RecordingError::Io {
                                     file: info.file.clone(),
@@ -366,7 +418,11 @@ impl<R: BufRead + Send> RecordingReader<R> {
                 res_rx.push(rr);
                 free_res.push(ft);
             }
-            scope.spawn(move || split(src, (carry, eof), job_bytes, job_tx, free_buf_rx));
+            if mapped.is_some() {
+                scope.spawn(move || split_map(map, job_bytes, job_tx));
+            } else {
+                scope.spawn(move || split(src, (carry, eof), job_bytes, job_tx, free_buf_rx));
+            }
             // `chunk` holds the rows read ahead at open that did not fill a chunk (maybe none)
             let mut result = Ok(true);
             'jobs: for k in 0.. {
@@ -395,7 +451,7 @@ impl<R: BufRead + Send> RecordingReader<R> {
                                 good = i - r;
                                 result = Err(e);
                                 // the serial reader has consumed the row's line
-                                bytes += p.bytes_through(p.line_of(i) + 1);
+                                bytes += p.bytes_through(map, p.line_of(i) + 1);
                                 break;
                             }
                         }
@@ -422,6 +478,9 @@ impl<R: BufRead + Send> RecordingReader<R> {
                 }
                 line_no += p.lines;
                 bytes += p.bytes;
+                if let (Some((a, b)), Some(m)) = (p.span, &mapped) {
+                    m.release(a, b);
+                }
                 free_buf_tx.send(std::mem::take(&mut p.text)).ok();
                 free_res[w].send(p).ok();
             }
@@ -434,6 +493,15 @@ impl<R: BufRead + Send> RecordingReader<R> {
             }
             result
         });
+        // a mapped file shortened meanwhile: its error, whatever the parse made of the zeros
+        // put where its end was (a stop asked by the caller stays a stop)
+        let ended = match mapped.and_then(|m| m.shortened()) {
+            Some(error) if !matches!(ended, Ok(false)) => Err(RecordingError::Io {
+                file: info.file.clone(),
+                error,
+            }),
+            _ => ended,
+        };
         self.lines.line_no = line_no;
         self.lines.bytes = bytes;
         self.sample = sample;

@@ -351,7 +351,8 @@ fn as_signal(c: &RecordingChunk, has_z: bool) -> signal::SignalChunk<'_> {
     }
 }
 
-/// Passes 2 and 3: the spill read back, on a second thread (issue 18: reading and decoding
+/// Passes 2 and 3: the spill mapped, its blocks fed as they lie in the file; where the process
+/// does not allow mapped files, read back on a second thread (issue 18: reading and decoding
 /// the next blocks overlaps the pipeline's work on the current one; blocks arrive in order,
 /// a read error after the blocks before it).
 fn replay(
@@ -360,10 +361,23 @@ fn replay(
     progress: &mut dyn Progress,
     sink: &mut signal::ChunkSink<'_>,
 ) -> Result<()> {
+    let path = spill.path().to_path_buf();
+    let context = || format!("reading temporary file {}", path.display());
+    if let Some(mut blocks) = spill.mapped().with_context(context)? {
+        // the file's pages themselves (`runout_io::mapped`): no copy, no reading thread
+        while let Some(cols) = blocks.next_block().with_context(context)? {
+            sink(signal::SignalChunk {
+                fx: cols[0],
+                fy: cols[1],
+                fz: has_z.then(|| cols[2]),
+                pulse: cols.get(3).copied(),
+            })?;
+            progress.advance((cols[0].len() * cols.len() * 8) as u64);
+        }
+        return blocks.finish().with_context(context);
+    }
     use std::sync::mpsc;
-    let mut r = spill
-        .reader()
-        .with_context(|| format!("reading temporary file {}", spill.path().display()))?;
+    let mut r = spill.reader().with_context(context)?;
     std::thread::scope(|scope| {
         let (full_tx, full_rx) = mpsc::sync_channel::<std::io::Result<RecordingChunk>>(AHEAD);
         let (free_tx, free_rx) = mpsc::channel::<RecordingChunk>();
