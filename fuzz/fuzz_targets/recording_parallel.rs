@@ -3,7 +3,8 @@
 //! against `read_chunk` in a loop, on 1100 well-formed rows followed by the fuzzer's bytes as
 //! more lines (the parallel path starts after the 1000 rows read ahead at open). Chunks (sizes,
 //! first samples, times and values bit for bit), the first error, the bytes read and the
-//! warnings must be the same.
+//! warnings must be the same. On Linux the same bytes are also written to a file and parsed
+//! mapped (`runout_io::mapped`), with the same result required.
 //!
 //! Run with `-detect_leaks=0`: LeakSanitizer reports the standard library's per-thread channel
 //! context (`std::sync::mpmc::context`, ≈ 112 bytes) of a worker thread that is still exiting
@@ -71,4 +72,27 @@ fuzz_target!(|data: &[u8]| {
     got.2 = parallel.bytes_read();
     got.3 = parallel.warnings().to_vec();
     assert!(got == want, "{:?}\n{:?}\n{} {}", got.1, want.1, got.2, want.2);
+    #[cfg(target_os = "linux")]
+    {
+        // the file's path in messages is the only difference allowed
+        let path = std::env::temp_dir().join(format!("fuzz-mapped-{}.csv", std::process::id()));
+        std::fs::write(&path, &bytes).expect("temporary file");
+        // SAFETY: the file is not written while it is read
+        unsafe { runout_io::mapped::allow_mapped_files() };
+        let name = path.display().to_string();
+        let mut mapped = RecordingReader::open(&path, &opts).expect("opened before");
+        let mut got: Seen = (Vec::new(), None, 0, Vec::new());
+        let mut chunks = Vec::new();
+        got.1 = mapped
+            .for_each_chunk_in_jobs_of(job_bytes, &mut c, 333, 2, |c, _, _| {
+                chunks.push(bits(c));
+                true
+            })
+            .err()
+            .map(|e| e.to_string().replace(&name, "f.csv"));
+        got.0 = chunks;
+        got.2 = mapped.bytes_read();
+        got.3 = mapped.warnings().iter().map(|w| w.replace(&name, "f.csv")).collect();
+        assert!(got == want, "mapped: {:?}\n{:?}\n{} {}", got.1, want.1, got.2, want.2);
+    }
 });
