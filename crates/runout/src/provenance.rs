@@ -145,8 +145,9 @@ pub struct InputHashing {
     hasher: Sha256,
     /// Bytes of the current input hashed.
     offset: u64,
-    /// The current input, open (shared with the clones; read at `offset`).
-    file: Option<std::sync::Arc<std::fs::File>>,
+    /// The current input, open (shared with the clones; read at `offset`), and its length
+    /// when it was opened.
+    file: Option<std::sync::Arc<(std::fs::File, u64)>>,
     /// Read buffer (not carried by a clone).
     buf: Vec<u8>,
 }
@@ -199,12 +200,25 @@ impl InputHashing {
             Some(f) => std::sync::Arc::clone(f),
             None => {
                 let f = std::fs::File::open(path).map_err(|e| named(source, e))?;
-                self.file.insert(std::sync::Arc::new(f)).clone()
+                let len = f.metadata().map_err(|e| named(source, e))?.len();
+                self.file.insert(std::sync::Arc::new((f, len))).clone()
             }
         };
+        let (file, opened_len) = &*file;
         self.buf.resize(STEP_BYTES, 0);
-        let n = read_some_at(&file, &mut self.buf, self.offset, source)?;
+        let n = read_some_at(file, &mut self.buf, self.offset, source)?;
         if n == 0 {
+            if self.offset != *opened_len {
+                // shortened or grown while it was hashed: the hash would be of neither the file
+                // that was opened nor, perhaps, the one the job read
+                return Err(named(
+                    source,
+                    std::io::Error::other(format!(
+                        "it changed while it was read ({opened_len} bytes when opened, {} read)",
+                        self.offset
+                    )),
+                ));
+            }
             self.close_input(source, self.offset);
         } else {
             self.hasher.update(&self.buf[..n]);
@@ -420,6 +434,34 @@ mod tests {
             (expected.size_bytes, &expected.sha256)
         );
         assert_eq!(hashing.finish().unwrap()[0].sha256, expected.sha256);
+    }
+
+    /// An input shortened or grown while it is hashed is an error naming it and both sizes: its
+    /// hash would be of neither the file that was opened nor, perhaps, the one the job read.
+    #[test]
+    fn an_input_changed_while_hashed_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("rec.txt");
+        let content: Vec<u8> = (0..3 * STEP_BYTES + 5).map(|k| (k % 241) as u8).collect();
+        for (new_len, read) in [
+            (STEP_BYTES + 9, STEP_BYTES + 9),
+            (5 * STEP_BYTES, 5 * STEP_BYTES),
+        ] {
+            std::fs::write(&p, &content).unwrap();
+            let mut hashing = InputHashing::new(vec![Source::path(&p)]);
+            hashing.step().unwrap();
+            let f = std::fs::OpenOptions::new().write(true).open(&p).unwrap();
+            f.set_len(new_len as u64).unwrap();
+            let e = hashing.finish().unwrap_err().to_string();
+            assert!(
+                e.contains("rec.txt")
+                    && e.contains(&format!(
+                        "changed while it was read ({} bytes when opened, {read} read)",
+                        content.len()
+                    )),
+                "{e}"
+            );
+        }
     }
 
     /// An input that cannot be read stops the hashing with an error naming it, at every try.
