@@ -13,14 +13,46 @@
 use libfuzzer_sys::fuzz_target;
 use runout_io::recording::{ReadOptions, RecordingChunk, RecordingReader};
 
-type Seen = (Vec<(u64, Vec<u64>, Vec<Vec<u64>>)>, Option<String>, u64, Vec<String>);
+type Seen = (
+    Vec<(u64, Vec<u64>, Vec<Vec<u64>>)>,
+    Option<String>,
+    u64,
+    Vec<String>,
+);
 
 fn bits(c: &RecordingChunk) -> (u64, Vec<u64>, Vec<Vec<u64>>) {
     (
         c.first_sample,
         c.time_s.iter().map(|t| t.to_bits()).collect(),
-        c.values.iter().map(|v| v.iter().map(|x| x.to_bits()).collect()).collect(),
+        c.values
+            .iter()
+            .map(|v| v.iter().map(|x| x.to_bits()).collect())
+            .collect(),
     )
+}
+
+/// What `for_each_chunk_in_jobs_of` gives on 2 threads, with the reader's name `name` in
+/// messages written as `f.csv`.
+fn in_jobs<R: std::io::BufRead + Send>(
+    mut r: RecordingReader<R>,
+    job_bytes: usize,
+    name: &str,
+) -> Seen {
+    let mut c = RecordingChunk::default();
+    let mut chunks = Vec::new();
+    let error = r
+        .for_each_chunk_in_jobs_of(job_bytes, &mut c, 333, 2, |c, _, _| {
+            chunks.push(bits(c));
+            true
+        })
+        .err()
+        .map(|e| e.to_string().replace(name, "f.csv"));
+    let warnings = r
+        .warnings()
+        .iter()
+        .map(|w| w.replace(name, "f.csv"))
+        .collect();
+    (chunks, error, r.bytes_read(), warnings)
 }
 
 fuzz_target!(|data: &[u8]| {
@@ -58,20 +90,16 @@ fuzz_target!(|data: &[u8]| {
     };
     want.2 = serial.bytes_read();
     want.3 = serial.warnings().to_vec();
-    let mut parallel = RecordingReader::from_bytes("f.csv", &bytes, &opts).expect("opened once");
-    let mut got: Seen = (Vec::new(), None, 0, Vec::new());
-    let mut chunks = Vec::new();
-    got.1 = parallel
-        .for_each_chunk_in_jobs_of(job_bytes, &mut c, 333, 2, |c, _, _| {
-            chunks.push(bits(c));
-            true
-        })
-        .err()
-        .map(|e| e.to_string());
-    got.0 = chunks;
-    got.2 = parallel.bytes_read();
-    got.3 = parallel.warnings().to_vec();
-    assert!(got == want, "{:?}\n{:?}\n{} {}", got.1, want.1, got.2, want.2);
+    let parallel = RecordingReader::from_bytes("f.csv", &bytes, &opts).expect("opened once");
+    let got = in_jobs(parallel, job_bytes, "f.csv");
+    assert!(
+        got == want,
+        "{:?}\n{:?}\n{} {}",
+        got.1,
+        want.1,
+        got.2,
+        want.2
+    );
     #[cfg(target_os = "linux")]
     {
         // the file's path in messages is the only difference allowed
@@ -79,20 +107,15 @@ fuzz_target!(|data: &[u8]| {
         std::fs::write(&path, &bytes).expect("temporary file");
         // SAFETY: the file is not written while it is read
         unsafe { runout_io::mapped::allow_mapped_files() };
-        let name = path.display().to_string();
-        let mut mapped = RecordingReader::open(&path, &opts).expect("opened before");
-        let mut got: Seen = (Vec::new(), None, 0, Vec::new());
-        let mut chunks = Vec::new();
-        got.1 = mapped
-            .for_each_chunk_in_jobs_of(job_bytes, &mut c, 333, 2, |c, _, _| {
-                chunks.push(bits(c));
-                true
-            })
-            .err()
-            .map(|e| e.to_string().replace(&name, "f.csv"));
-        got.0 = chunks;
-        got.2 = mapped.bytes_read();
-        got.3 = mapped.warnings().iter().map(|w| w.replace(&name, "f.csv")).collect();
-        assert!(got == want, "mapped: {:?}\n{:?}\n{} {}", got.1, want.1, got.2, want.2);
+        let mapped = RecordingReader::open(&path, &opts).expect("opened before");
+        let got = in_jobs(mapped, job_bytes, &path.display().to_string());
+        assert!(
+            got == want,
+            "mapped: {:?}\n{:?}\n{} {}",
+            got.1,
+            want.1,
+            got.2,
+            want.2
+        );
     }
 });
