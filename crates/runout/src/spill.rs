@@ -87,12 +87,18 @@ impl Spill {
         Ok(())
     }
 
+    /// Flush the blocks written (once; later writes panic).
+    fn finish_writing(&mut self) -> io::Result<()> {
+        match self.writer.take() {
+            Some(mut w) => w.flush(),
+            None => Ok(()),
+        }
+    }
+
     /// Finish writing and map the blocks (`None` when the process does not allow mapped files,
     /// the spill is empty, or on a big-endian machine: then [`Spill::reader`]).
     pub fn mapped(&mut self) -> io::Result<Option<MappedSpill>> {
-        if let Some(mut w) = self.writer.take() {
-            w.flush()?;
-        }
+        self.finish_writing()?;
         if cfg!(target_endian = "big") {
             return Ok(None);
         }
@@ -101,15 +107,13 @@ impl Spill {
             map,
             channels: self.channels,
             pos: 0,
-            read: 0,
+            released: 0,
         }))
     }
 
     /// Finish writing and read the blocks back from the start.
     pub fn reader(&mut self) -> io::Result<SpillReader> {
-        if let Some(mut w) = self.writer.take() {
-            w.flush()?;
-        }
+        self.finish_writing()?;
         let f = File::open(&self.path)?;
         Ok(SpillReader {
             r: BufReader::with_capacity(BUFFER_BYTES, f),
@@ -177,8 +181,8 @@ pub struct MappedSpill {
     channels: usize,
     /// Where the next block starts (bytes).
     pos: usize,
-    /// Bytes of the blocks handed out so far (released at the next block).
-    read: usize,
+    /// Bytes released from memory: the blocks before `released` have been handed out and used.
+    released: usize,
 }
 
 impl MappedSpill {
@@ -186,7 +190,8 @@ impl MappedSpill {
     /// before is released from the process's memory (`MappedFile::release`). An error when the
     /// file does not hold the block its row count announces.
     pub fn next_block(&mut self) -> io::Result<Option<Vec<&[f64]>>> {
-        self.map.release(0, self.read);
+        self.map.release(self.released, self.pos);
+        self.released = self.pos;
         let bytes = self.map.bytes();
         let Some(head) = bytes.get(self.pos..self.pos + 8) else {
             return if self.pos == bytes.len() {
@@ -213,7 +218,6 @@ impl MappedSpill {
             })
             .collect::<io::Result<Vec<&[f64]>>>()?;
         self.pos = end;
-        self.read = end;
         Ok(Some(columns))
     }
 
@@ -321,7 +325,7 @@ mod tests {
             map: MappedFile::new(File::open(&copy).unwrap(), 0).unwrap(),
             channels: 2,
             pos: 0,
-            read: 0,
+            released: 0,
         };
         let mut blocks = 0;
         let e = loop {
