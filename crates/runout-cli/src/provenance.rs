@@ -32,6 +32,8 @@ const CHECKPOINT_STEPS: u64 = 16;
 /// thread that will finish it.
 struct Pending {
     args: Vec<String>,
+    /// Inputs that can be read only once (pipes, FIFOs, devices): named, not hashed.
+    streams: Vec<String>,
     shared: Arc<Shared>,
 }
 
@@ -69,7 +71,9 @@ enum Outcome {
 /// Starts hashing the inputs named on `args` (program name first) and registers the plots'
 /// metadata provider.
 pub fn start(args: Vec<String>) {
-    let inputs: Vec<Source> = input_files(&args).into_iter().map(Source::path).collect();
+    let named = named_inputs(&args);
+    let streams = named.streams;
+    let inputs: Vec<Source> = named.files.into_iter().map(Source::path).collect();
     let hashing = InputHashing::new(inputs);
     let shared = Arc::new(Shared {
         latest: Mutex::new(Ok(hashing.clone())),
@@ -80,7 +84,11 @@ pub fn start(args: Vec<String>) {
         lowest_priority();
         hash_in_background(hashing, &background);
     });
-    *PENDING.lock().unwrap_or_else(|e| e.into_inner()) = Some(Pending { args, shared });
+    *PENDING.lock().unwrap_or_else(|e| e.into_inner()) = Some(Pending {
+        args,
+        streams,
+        shared,
+    });
     runout_io::plot::metadata::set_provider(Some(Box::new(|| get().map(Provenance::summary_line))));
 }
 
@@ -111,7 +119,9 @@ fn settle(pending: Pending) -> Outcome {
     pending.shared.stop.store(true, Ordering::Relaxed);
     let latest = pending.shared.swap(Err(String::new()));
     match latest.and_then(|h| h.finish().map_err(|e| e.to_string())) {
-        Ok(inputs) => Outcome::Done(Provenance::of_inputs(pending.args, inputs)),
+        Ok(inputs) => Outcome::Done(
+            Provenance::of_inputs(pending.args, inputs).with_not_hashed(pending.streams),
+        ),
         Err(why) => Outcome::Failed(why),
     }
 }
@@ -143,7 +153,7 @@ pub fn get() -> Option<&'static Provenance> {
 
 /// The hashing's result, settled once ([`settle`]); a failure is told on stderr then (once,
 /// unless `--quiet`): the outputs go without provenance. It never waits for the background
-/// thread: it reads the rest of the input files itself (regular files: [`input_files`] names
+/// thread: it reads the rest of the input files itself (regular files: [`named_inputs`] hashes
 /// no FIFO or device).
 fn outcome() -> &'static Outcome {
     DONE.get_or_init(|| {
@@ -163,6 +173,11 @@ fn warning(outcome: &Outcome) -> Option<String> {
     match outcome {
         Outcome::Failed(why) => Some(format!(
             "the outputs carry no provenance (command line, inputs' SHA-256): {why}"
+        )),
+        Outcome::Done(p) if !p.not_hashed.is_empty() => Some(format!(
+            "the outputs' provenance names {} without a SHA-256: a pipe or device is read once, by \
+             the job (give a file to have its content hashed)",
+            p.not_hashed.join(", ")
         )),
         Outcome::NotStarted | Outcome::Done(_) => None,
     }
@@ -210,22 +225,44 @@ pub const OUTPUT_FLAGS: &[&str] = &[
 #[cfg(test)]
 const INPUT_FLAGS: &[&str] = &["config", "sensor-frf", "probe", "generatrix", "nc"];
 
-/// The input files named on the command line `args` (program name first; the command line of
-/// this program, parsed again): the value of every argument, positional or option, other than
-/// the options in [`OUTPUT_FLAGS`], that is an existing regular file, or `FILE:SELECTOR` whose
-/// `FILE` is one. In command-line order, each once.
-pub fn input_files(args: &[String]) -> Vec<String> {
+/// The inputs named on the command line (program name first; the command line of this program,
+/// parsed again): the value of every argument, positional or option, other than the options in
+/// [`OUTPUT_FLAGS`], that exists.
+pub struct NamedInputs {
+    /// Regular files, or `FILE:SELECTOR` whose `FILE` is one (hashed).
+    pub files: Vec<String>,
+    /// Those that can be read only once: a pipe such as `/dev/fd/63` from `<(…)`, standard
+    /// input, a FIFO, a device (named only, never opened here: a second reader would take bytes
+    /// from the job's).
+    pub streams: Vec<String>,
+}
+
+/// [`NamedInputs`] of `args`, in command-line order, each once.
+pub fn named_inputs(args: &[String]) -> NamedInputs {
     use clap::CommandFactory;
+    let mut named = NamedInputs {
+        files: Vec::new(),
+        streams: Vec::new(),
+    };
     let cmd = crate::Cli::command();
     // the command line was parsed by `main` before: this cannot fail
     let Ok(matches) = cmd.clone().try_get_matches_from(args) else {
-        return Vec::new();
+        return named;
     };
     let mut values: Vec<(usize, &str)> = Vec::new();
     collect_values(&cmd, &matches, &mut values);
     values.sort_by_key(|&(index, _)| index);
-    let mut files: Vec<String> = Vec::new();
+    let files = &mut named.files;
     for (_, value) in values {
+        // (`-`: standard input, where a command reads it)
+        let stream =
+            value == "-" || std::fs::metadata(value).is_ok_and(|m| !m.is_file() && !m.is_dir());
+        if stream {
+            if !named.streams.iter().any(|g| g == value) {
+                named.streams.push(value.to_string());
+            }
+            continue;
+        }
         let candidate = if Path::new(value).is_file() {
             Some(value)
         } else {
@@ -240,7 +277,7 @@ pub fn input_files(args: &[String]) -> Vec<String> {
             }
         }
     }
-    files
+    named
 }
 
 /// The values given on the command line to the arguments of `cmd` (and of the subcommand
@@ -298,7 +335,50 @@ mod tests {
             "--rpm".into(),
             "3000".into(),
         ];
-        assert_eq!(input_files(&args), vec![s(&a), s(&m)]);
+        assert_eq!(named_inputs(&args).files, vec![s(&a), s(&m)]);
+    }
+
+    /// A FIFO (as a pipe from `<(…)` or standard input) named on the command line is never
+    /// opened for hashing: a second reader would take its bytes from the job. The provenance
+    /// names it without a hash and the user is told.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn pipes_and_fifos_are_named_not_hashed() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("rec.fifo");
+        let c = std::ffi::CString::new(fifo.display().to_string()).unwrap();
+        // SAFETY: a NUL-terminated path; mkfifo only creates the node
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let cfg = dir.path().join("cut.toml");
+        std::fs::write(&cfg, "teeth = 4").unwrap();
+        let s = |p: &Path| p.display().to_string();
+        let args: Vec<String> = vec![
+            "runout".into(),
+            "identify".into(),
+            s(&fifo),
+            s(&fifo),
+            "--config".into(),
+            s(&cfg),
+        ];
+        // (opening the FIFO to read it would block here: nobody writes to it)
+        let named = named_inputs(&args);
+        assert_eq!(named.files, vec![s(&cfg)]);
+        assert_eq!(named.streams, vec![s(&fifo)]);
+        let hashed = InputHashing::new(named.files.into_iter().map(Source::path).collect());
+        let p =
+            Provenance::of_inputs(args, hashed.finish().unwrap()).with_not_hashed(named.streams);
+        let json = serde_json::to_value(&p).unwrap();
+        assert_eq!(json["not_hashed"][0], s(&fifo));
+        assert_eq!(json["inputs"].as_array().unwrap().len(), 1);
+        let told = warning(&Outcome::Done(p)).expect("the user is told");
+        assert!(told.contains(&s(&fifo)) && told.contains("pipe"), "{told}");
+        // without such inputs the field is left out and nothing is said
+        let plain = Provenance::of_inputs(["runout"], vec![]);
+        assert!(serde_json::to_value(&plain)
+            .unwrap()
+            .get("not_hashed")
+            .is_none());
+        assert!(warning(&Outcome::Done(plain)).is_none());
     }
 
     /// The old content of an output is not an input, however the flag is written (`--json F`,
@@ -329,7 +409,10 @@ mod tests {
             "--plot-dir",
             &plots.display().to_string(),
         ]);
-        assert_eq!(input_files(&args), vec![cfg.clone(), rec.clone(), frf]);
+        assert_eq!(
+            named_inputs(&args).files,
+            vec![cfg.clone(), rec.clone(), frf]
+        );
         let (csv, dwd) = (file("old.csv"), file("old.txt"));
         let args = strings(&[
             "runout",
@@ -346,7 +429,7 @@ mod tests {
             "--plot",
             &plot,
         ]);
-        assert_eq!(input_files(&args), vec![cfg.clone()]);
+        assert_eq!(named_inputs(&args).files, vec![cfg.clone()]);
         let (nc, probe, out_nc, path_csv) = (
             file("in.nc"),
             file("probe.csv"),
@@ -366,7 +449,7 @@ mod tests {
             "--path-out",
             &path_csv,
         ]);
-        assert_eq!(input_files(&args), vec![nc, probe]);
+        assert_eq!(named_inputs(&args).files, vec![nc, probe]);
     }
 
     /// Every option whose value is a path is classified as written ([`OUTPUT_FLAGS`]) or read
@@ -453,7 +536,15 @@ mod tests {
             stop: AtomicBool::new(false),
         });
         let args = vec!["runout".to_string(), "x".to_string()];
-        (Pending { args, shared }, hashing)
+        let streams = Vec::new();
+        (
+            Pending {
+                args,
+                streams,
+                shared,
+            },
+            hashing,
+        )
     }
 
     /// The hashing is finished by the thread that needs it, whatever the background thread did:

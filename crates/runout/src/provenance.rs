@@ -33,6 +33,12 @@ pub struct Provenance {
     pub command_line: Vec<String>,
     /// Every input file or in-memory source the job read, in the order given.
     pub inputs: Vec<InputFile>,
+    /// Inputs named on the command line that can be read only once (a pipe such as
+    /// `<(zcat rec.txt.gz)` or standard input, a FIFO, a device): the job read them, so they
+    /// could not be read again to hash them. Their names as given; left out of the JSON when
+    /// empty. A report with such inputs cannot be traced back to their content.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub not_hashed: Vec<String>,
     /// When the report was made: UTC, RFC 3339 with seconds (`2026-11-25T07:12:03Z`).
     pub created_utc: String,
 }
@@ -73,8 +79,24 @@ impl Provenance {
             tool: format!("runout {}", env!("CARGO_PKG_VERSION")),
             command_line: command_line.into_iter().map(Into::into).collect(),
             inputs,
+            not_hashed: Vec::new(),
             created_utc: utc_now_rfc3339(),
         }
+    }
+
+    /// The same provenance, naming `streams` as inputs that were read once and not hashed
+    /// ([`Provenance::not_hashed`]).
+    ///
+    /// ```
+    /// use runout::provenance::Provenance;
+    /// let p = Provenance::of_inputs(["runout", "identify", "/dev/stdin"], vec![])
+    ///     .with_not_hashed(vec!["/dev/stdin".into()]);
+    /// assert_eq!(p.not_hashed, ["/dev/stdin"]);
+    /// assert!(p.summary_line().ends_with("[inputs: ; not hashed (read once): /dev/stdin]"));
+    /// ```
+    pub fn with_not_hashed(mut self, streams: Vec<String>) -> Self {
+        self.not_hashed = streams;
+        self
     }
 
     /// One line for the metadata of a plot: tool, time, command line and the inputs' hashes
@@ -85,8 +107,13 @@ impl Provenance {
             .iter()
             .map(|i| format!("{} sha256:{}", i.name, &i.sha256[..12]))
             .collect();
+        let streams = if self.not_hashed.is_empty() {
+            String::new()
+        } else {
+            format!("; not hashed (read once): {}", self.not_hashed.join(", "))
+        };
         format!(
-            "{} at {}: {} [inputs: {}]",
+            "{} at {}: {} [inputs: {}{streams}]",
             self.tool,
             self.created_utc,
             self.command_line.join(" "),

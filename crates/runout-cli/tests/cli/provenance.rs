@@ -144,3 +144,82 @@ fn an_existing_output_is_not_an_input() {
         .collect();
     assert_eq!(names, ["cut_fz0.05.txt", "cut_fz0.08.txt", "cut.toml"]);
 }
+
+/// A recording from standard input (`-`) gives the answer the file gives; the provenance names
+/// `-` without a hash (the job read it: it cannot be read again) and says so. A second `-` is
+/// an error. (`-` was read as a file named "-"; a pipe path such as `<(cat rec.txt)` was opened
+/// twice and its header lost: "no sample rate".)
+#[cfg(unix)]
+#[test]
+fn a_recording_from_standard_input_gives_the_files_answer() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = example("..");
+    let answer = |json: &Path| {
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+        let mut answer = v["answer"].clone();
+        // the recordings by name: `/dev/stdin` for `-`
+        for c in answer["cross_checks"].as_array_mut().unwrap() {
+            c["file"] = serde_json::Value::Null;
+        }
+        (answer, v["full_signal"].clone(), v["provenance"].clone())
+    };
+    let files = dir.path().join("files.json");
+    runout()
+        .current_dir(&root)
+        .args(IDENTIFY_EXAMPLE_INPUTS)
+        .arg("--json")
+        .arg(&files)
+        .assert()
+        .success();
+    let piped = dir.path().join("stdin.json");
+    let out = runout()
+        .current_dir(&root)
+        .args([
+            "identify",
+            "-",
+            "examples/identify/cut_fz0.08.txt",
+            "--config",
+            "examples/identify/cut.toml",
+            "--json",
+        ])
+        .arg(&piped)
+        .pipe_stdin(root.join("examples/identify/cut_fz0.05.txt"))
+        .unwrap()
+        .assert()
+        .success();
+    let stderr = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+    let (want, want_fit, _) = answer(&files);
+    let (got, got_fit, provenance) = answer(&piped);
+    assert_eq!(got, want);
+    assert_eq!(got_fit, want_fit);
+    assert_eq!(provenance["not_hashed"], serde_json::json!(["-"]));
+    let hashed: Vec<&str> = provenance["inputs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| i["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        hashed,
+        [
+            "examples/identify/cut_fz0.08.txt",
+            "examples/identify/cut.toml"
+        ]
+    );
+    assert!(stderr.contains("names - without a SHA-256"), "{stderr}");
+    // standard input can be read once
+    runout()
+        .current_dir(&root)
+        .args([
+            "identify",
+            "-",
+            "-",
+            "--config",
+            "examples/identify/cut.toml",
+        ])
+        .write_stdin("")
+        .assert()
+        .code(1)
+        .stderr(predicates::str::contains("given 2 times"));
+}

@@ -23,6 +23,26 @@ pub enum Kind {
     Parquet,
 }
 
+impl Kind {
+    /// The format's name, for messages.
+    ///
+    /// ```
+    /// use runout_io::formats::Kind;
+    /// assert_eq!(Kind::Tdms.name(), "TDMS");
+    /// ```
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Text => "text",
+            Kind::Mat5 => "MATLAB .mat",
+            Kind::Mat4 => "MATLAB v4 .mat",
+            Kind::Hdf5 { offset: 0 } => "HDF5",
+            Kind::Hdf5 { .. } => "MATLAB v7.3 / HDF5",
+            Kind::Tdms => "TDMS",
+            Kind::Parquet => "Parquet",
+        }
+    }
+}
+
 /// The HDF5 superblock signature.
 pub const HDF5_SIGNATURE: [u8; 8] = [0x89, b'H', b'D', b'F', b'\r', b'\n', 0x1a, b'\n'];
 

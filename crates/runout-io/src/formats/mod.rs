@@ -30,7 +30,7 @@ use crate::recording::{
 };
 use serde::Serialize;
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
 type Result<T> = std::result::Result<T, RecordingError>;
@@ -157,18 +157,16 @@ pub fn open_recording(
 ) -> Result<RecordingReader<BufReader<File>>> {
     let (path, selector) = split_selector(path.as_ref());
     let file = path.display().to_string();
+    if std::fs::metadata(&path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        return open_stream(&path, &file, selector.as_deref(), options);
+    }
     let kind = detect_file(&path).map_err(|error| RecordingError::Io {
         file: file.clone(),
         error,
     })?;
     if kind == Kind::Text {
         if let Some(sel) = selector {
-            return Err(RecordingError::Format {
-                file,
-                message: format!(
-                    "a selector (`:{sel}`) applies to .mat, TDMS, HDF5 and Parquet files, not to text recordings"
-                ),
-            });
+            return Err(selector_on_text(file, &sel));
         }
         return RecordingReader::open(&path, options);
     }
@@ -180,6 +178,48 @@ pub fn open_recording(
         error,
     })?;
     Ok(RecordingReader::from_binary(BufReader::new(f), rec))
+}
+
+/// A recording that can be read only once, in order: a pipe (`<(zcat rec.txt.gz)`, standard
+/// input), a FIFO or a device. Opened once and its format detected from the first bytes the
+/// reader holds, so no byte is read twice or lost (a second open of a pipe would start where the
+/// first read stopped). Only text recordings are read this way: the binary formats need to seek.
+fn open_stream(
+    path: &Path,
+    file: &str,
+    selector: Option<&str>,
+    options: &ReadOptions,
+) -> Result<RecordingReader<BufReader<File>>> {
+    let io = |error| RecordingError::Io {
+        file: file.to_string(),
+        error,
+    };
+    let mut src = BufReader::with_capacity(1 << 16, File::open(path).map_err(io)?);
+    let kind = detect(src.fill_buf().map_err(io)?);
+    if kind != Kind::Text {
+        return Err(RecordingError::Format {
+            file: file.to_string(),
+            message: format!(
+                "a {} file cannot be read from a pipe or device (it is read with random access): \
+                 save it to a file and give that path",
+                kind.name()
+            ),
+        });
+    }
+    if let Some(sel) = selector {
+        return Err(selector_on_text(file.to_string(), sel));
+    }
+    RecordingReader::from_reader(src, file, options)
+}
+
+/// The error for a `:SEL` selector given with a text recording.
+fn selector_on_text(file: String, sel: &str) -> RecordingError {
+    RecordingError::Format {
+        file,
+        message: format!(
+            "a selector (`:{sel}`) applies to .mat, TDMS, HDF5 and Parquet files, not to text recordings"
+        ),
+    }
 }
 
 /// Like [`open_recording`] for a file held in memory; `name` is used in messages, `selector` as

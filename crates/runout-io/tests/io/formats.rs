@@ -218,3 +218,99 @@ fn inspect_lists_channels_lengths_rates() {
         .any(|e| e.name == "rec800.Fy" && e.len == 200));
     assert!(c.entries.iter().any(|e| e.name == "note" && !e.readable));
 }
+
+/// A FIFO at `dir/name` whose writer thread writes `bytes` once a reader opens it.
+#[cfg(target_os = "linux")]
+fn fifo_with(dir: &Path, name: &str, bytes: Vec<u8>) -> (PathBuf, std::thread::JoinHandle<()>) {
+    use std::io::Write;
+    let p = dir.join(name);
+    let c = std::ffi::CString::new(p.display().to_string()).unwrap();
+    // SAFETY: a NUL-terminated path; mkfifo only creates the node
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let q = p.clone();
+    let writer = std::thread::spawn(move || {
+        // blocks until the reader opens; a reader that stops early breaks the pipe (ignored)
+        let mut f = std::fs::OpenOptions::new().write(true).open(q).unwrap();
+        let _ = f.write_all(&bytes);
+    });
+    (p, writer)
+}
+
+/// `f()` on a thread, against a deadline of a minute: a second open of a FIFO would wait for a
+/// writer forever (the old reader opened a recording twice).
+fn within_a_minute<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || tx.send(f()).ok());
+    rx.recv_timeout(std::time::Duration::from_secs(60))
+        .expect("the pipe is opened and read within a minute")
+}
+
+/// All of a reader's rows: the time base and each channel.
+fn read_all_rows<R: std::io::BufRead>(
+    r: &mut runout_io::recording::RecordingReader<R>,
+) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let (mut times, mut values) = (Vec::new(), Vec::new());
+    let mut c = RecordingChunk::default();
+    while r.read_chunk(&mut c, 1000).unwrap() > 0 {
+        times.extend_from_slice(&c.time_s);
+        values.resize(c.values.len(), Vec::new());
+        for (g, v) in values.iter_mut().zip(&c.values) {
+            g.extend_from_slice(v);
+        }
+    }
+    (times, values)
+}
+
+/// A text recording from a pipe (`<(zcat rec.txt.gz)`, standard input, a FIFO) is opened once
+/// and read from its first byte: the same header, rate and rows as from a file. (It was opened
+/// twice — once to detect the format, once to read — and the second reader started after the
+/// bytes the first had taken: "no sample rate" or "no column Fx" for a DynoWare export.)
+#[cfg(target_os = "linux")]
+#[test]
+fn a_text_recording_is_read_from_a_pipe_as_from_a_file() {
+    let mut text = String::from(
+        "DynoWare,Version 2.5.1.2\nSampling rate [Hz]:,2000\nTime,Fx,Fy,Fz\ns,N,N,N\n",
+    );
+    for k in 0..20_000 {
+        let t = k as f64 / 2000.0;
+        let line = format!("{t},{:.4},{:.4},{:.4}\n", (7.0 * t).sin(), -t, 0.5 * t);
+        text.push_str(&line);
+    }
+    assert!(text.len() > 4 << 16, "longer than a pipe's buffer");
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("rec.txt");
+    std::fs::write(&file, &text).unwrap();
+    let opts = ReadOptions::new().channels(&["Fx", "Fy", "Fz"]);
+    let mut from_file = open_recording(&file, &opts).unwrap();
+    let want = read_all_rows(&mut from_file);
+    assert_eq!(want.0.len(), 20_000);
+    let (fifo, writer) = fifo_with(dir.path(), "rec.fifo", text.into_bytes());
+    let source = from_file.info().sample_rate_source.clone();
+    let (info, got) = within_a_minute(move || {
+        let mut r = open_recording(&fifo, &opts).unwrap();
+        (r.info().clone(), read_all_rows(&mut r))
+    });
+    assert_eq!(info.sample_rate_hz, 2000.0);
+    assert_eq!(info.sample_rate_source, source);
+    assert_eq!(got, want);
+    writer.join().unwrap();
+}
+
+/// A binary format needs to seek: from a pipe it is a clear error naming the file and the
+/// format, not a misread.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_binary_recording_from_a_pipe_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let bytes = std::fs::read(fixtures().join("tdms_interleaved.tdms")).unwrap();
+    let (fifo, writer) = fifo_with(dir.path(), "rec.fifo", bytes);
+    let e = within_a_minute(move || open_recording(&fifo, &ReadOptions::new()).err())
+        .expect("a TDMS file from a pipe is an error");
+    let msg = e.to_string();
+    assert!(matches!(e, RecordingError::Format { .. }), "{msg}");
+    assert!(
+        msg.contains("rec.fifo") && msg.contains("TDMS") && msg.contains("pipe"),
+        "{msg}"
+    );
+    writer.join().unwrap();
+}

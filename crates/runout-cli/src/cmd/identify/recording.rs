@@ -15,7 +15,8 @@ use std::path::{Path, PathBuf};
 #[derive(clap::Args, Debug, Default)]
 pub struct RecordingArgs {
     /// Force recordings (Kistler DynoWare text export, or CSV/TSV with a header row); several
-    /// recordings at different feeds are fitted jointly.
+    /// recordings at different feeds are fitted jointly. `-` reads one text recording from
+    /// standard input (as does a pipe, e.g. `<(zcat rec.txt.gz)`).
     #[arg(value_name = "RECORDING")]
     pub recordings: Vec<PathBuf>,
     /// Cut description (TOML) with the keys of the flags below.
@@ -128,11 +129,12 @@ pub fn run(a: RecordingArgs) -> Result<()> {
     if a.recordings.is_empty() {
         bail!("no recording given: `runout identify RECORDING… --config cut.toml` (or `runout identify peaks|tests`)");
     }
-    let sources = a.recordings.iter().map(Source::path).collect();
+    let recordings = stdin_as_path(&a.recordings)?;
+    let sources = recordings.iter().map(Source::path).collect();
     let config = a.config.as_ref().map(Source::path);
     let mut req = identify::resolve(config.as_ref(), a.layer(), sources)?;
     req.time_var = a.time.time_var.clone();
-    let mut inputs: Vec<&Path> = a.recordings.iter().map(|p| p.as_path()).collect();
+    let mut inputs: Vec<&Path> = recordings.iter().map(|p| p.as_path()).collect();
     if let Some(c) = &a.config {
         inputs.push(c);
     }
@@ -160,4 +162,22 @@ pub fn run(a: RecordingArgs) -> Result<()> {
         super::plots::write(dir, ext, &report)?;
     }
     Ok(())
+}
+
+/// The recordings with `-` read as standard input (`/dev/stdin`), which can be given once.
+fn stdin_as_path(recordings: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let dashes = recordings.iter().filter(|p| p.as_os_str() == "-").count();
+    if dashes > 1 {
+        bail!("`-` (standard input) is given {dashes} times among the recordings: it can be read once");
+    }
+    Ok(recordings
+        .iter()
+        .map(|p| {
+            if p.as_os_str() == "-" {
+                PathBuf::from("/dev/stdin")
+            } else {
+                p.clone()
+            }
+        })
+        .collect())
 }
