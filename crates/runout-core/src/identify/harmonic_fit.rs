@@ -1143,17 +1143,15 @@ fn scan_runouts(
                 let _g = GroupingScope::new(g);
                 q.set_runout(e);
                 let key: Vec<f64> = (0..nr).map(|i| q.x[i]).collect();
-                let fresh = match cached.iter().find(|(k, _)| *k == key) {
-                    Some((_, b)) => {
-                        q.basis.clone_from(b);
-                        None
-                    }
+                // (the tables straight from the cached basis, or from the one computed here,
+                // which is then handed out rather than copied: only the tables read the basis)
+                let (tables, fresh) = match cached.iter().find(|(k, _)| *k == key) {
+                    Some((_, b)) => (q.tables_for(b), None),
                     None => {
                         q.recompute();
-                        Some(q.basis.clone())
+                        (q.tables(), Some(std::mem::take(&mut q.basis)))
                     }
                 };
-                let tables = q.tables();
                 let solved = q.linear_coefficients_with(&tables).is_ok();
                 let c = if solved {
                     q.residual_vec_with(&tables).iter().map(|r| r * r).sum()
@@ -1166,33 +1164,34 @@ fn scan_runouts(
         .collect();
     let mut scored: Vec<(f64, DVector<f64>)> = Vec::new();
     let mut last_kc: Option<Vec<f64>> = None;
+    let mut last_key: Option<Vec<f64>> = None;
     for (key, fresh, c, x, solved) in evaluated {
         // the cache as the serial loop fills it (a key repeated among the candidates is
         // stored once, with the basis of its first evaluation: the same values)
-        let basis = match fresh {
-            Some(b) => match cache.iter().find(|(k, _)| *k == key) {
-                Some((_, b0)) => b0.clone(),
-                None => {
-                    cache.push((key.clone(), b.clone()));
-                    b
-                }
-            },
-            None => cache
-                .iter()
-                .find(|(k, _)| *k == key)
-                .map(|(_, b)| b.clone())
-                .unwrap_or_default(),
-        };
+        if let Some(b) = fresh {
+            if !cache.iter().any(|(k, _)| *k == key) {
+                cache.push((key.clone(), b));
+            }
+        }
         if solved {
             last_kc = Some((0..nk).map(|i| x[c0 + i]).collect());
         }
-        for (i, v) in key.iter().enumerate() {
-            p.x[i] = *v;
-        }
-        p.basis = basis;
+        last_key = Some(key);
         if c.is_finite() {
             scored.push((c, x));
         }
+    }
+    // p's runout and basis as the serial loop leaves them: the last candidate's (its basis is
+    // in the cache now; copied once, not at every candidate)
+    if let Some(key) = last_key {
+        for (i, v) in key.iter().enumerate() {
+            p.x[i] = *v;
+        }
+        p.basis = cache
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, b)| b.clone())
+            .unwrap_or_default();
     }
     if let Some(kc) = last_kc {
         for (i, v) in kc.iter().enumerate() {
