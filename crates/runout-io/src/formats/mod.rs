@@ -157,7 +157,7 @@ pub fn open_recording(
 ) -> Result<RecordingReader<BufReader<File>>> {
     let (path, selector) = split_selector(path.as_ref());
     let file = path.display().to_string();
-    if std::fs::metadata(&path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+    if is_stream(&path) {
         return open_stream(&path, &file, selector.as_deref(), options);
     }
     let kind = detect_file(&path).map_err(|error| RecordingError::Io {
@@ -178,6 +178,12 @@ pub fn open_recording(
         error,
     })?;
     Ok(RecordingReader::from_binary(BufReader::new(f), rec))
+}
+
+/// Whether `path` names something that can be read only once, in order (a pipe, a FIFO, a
+/// device): neither a regular file nor a folder.
+fn is_stream(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
 /// A recording that can be read only once, in order: a pipe (`<(zcat rec.txt.gz)`, standard
@@ -306,14 +312,18 @@ pub fn open_bytes(kind: Kind, bytes: &[u8], file: &str) -> Result<Opened> {
 /// What `runout inspect` prints: the catalog of a binary file, or the header of a text one.
 pub fn inspect(path: &Path, options: &ReadOptions) -> Result<Catalog> {
     let file = path.display().to_string();
-    let kind = detect_file(path).map_err(|error| RecordingError::Io {
-        file: file.clone(),
-        error,
-    })?;
-    if kind != Kind::Text {
-        return Ok(open_kind(kind, path, &file)?.catalog);
-    }
-    let r = RecordingReader::open(path, options)?;
+    let r = if is_stream(path) {
+        open_stream(path, &file, None, options)?
+    } else {
+        let kind = detect_file(path).map_err(|error| RecordingError::Io {
+            file: file.clone(),
+            error,
+        })?;
+        if kind != Kind::Text {
+            return Ok(open_kind(kind, path, &file)?.catalog);
+        }
+        RecordingReader::open(path, options)?
+    };
     let info = r.info();
     let mut entries = Vec::new();
     for c in info.time_column.iter().chain(&info.channels) {

@@ -294,6 +294,13 @@ fn a_text_recording_is_read_from_a_pipe_as_from_a_file() {
     assert_eq!(info.sample_rate_source, source);
     assert_eq!(got, want);
     writer.join().unwrap();
+    // `inspect` (`runout inspect <(cat rec.txt)`) lists what the pipe holds
+    let (fifo, writer) = fifo_with(dir.path(), "rec2.fifo", std::fs::read(&file).unwrap());
+    let catalog = within_a_minute(move || inspect(&fifo, &ReadOptions::new()).unwrap());
+    let names: Vec<&str> = catalog.entries.iter().map(|e| e.name.as_str()).collect();
+    assert_eq!(names, ["Time", "Fx", "Fy", "Fz"]);
+    assert_eq!(catalog.entries[1].sample_rate_hz, Some(2000.0));
+    writer.join().unwrap(); // (the inspection reads the head only: the writer meets a closed pipe)
 }
 
 /// A binary format needs to seek: from a pipe it is a clear error naming the file and the
