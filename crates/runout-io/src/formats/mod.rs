@@ -150,7 +150,8 @@ pub fn split_selector(spec: &Path) -> (PathBuf, Option<String>) {
 
 /// Open a recording of any supported format, detected by content (magic bytes): DynoWare/CSV/TSV
 /// text, MATLAB `.mat` v5 / v7.3, NI TDMS, HDF5, Parquet. `path` may carry
-/// a selector, `data.mat:600` (see the module documentation).
+/// a selector, `data.mat:600` (see the module documentation). A pipe, FIFO or device (e.g.
+/// `/dev/stdin`) is opened once and read in order: text recordings only.
 pub fn open_recording(
     path: impl AsRef<Path>,
     options: &ReadOptions,
