@@ -252,18 +252,13 @@ pub fn named_inputs(args: &[String]) -> NamedInputs {
     let mut values: Vec<(usize, &str)> = Vec::new();
     collect_values(&cmd, &matches, &mut values);
     values.sort_by_key(|&(index, _)| index);
-    let files = &mut named.files;
     for (_, value) in values {
         // (`-`: standard input, where a command reads it)
-        let stream =
-            value == "-" || std::fs::metadata(value).is_ok_and(|m| !m.is_file() && !m.is_dir());
-        if stream {
-            if !named.streams.iter().any(|g| g == value) {
-                named.streams.push(value.to_string());
-            }
+        if value == "-" || runout_io::formats::is_stream(Path::new(value)) {
+            push_once(&mut named.streams, value);
             continue;
         }
-        let candidate = if Path::new(value).is_file() {
+        let file = if Path::new(value).is_file() {
             Some(value)
         } else {
             value
@@ -271,13 +266,18 @@ pub fn named_inputs(args: &[String]) -> NamedInputs {
                 .map(|(file, _)| file)
                 .filter(|f| Path::new(f).is_file())
         };
-        if let Some(f) = candidate {
-            if !files.iter().any(|g| g == f) {
-                files.push(f.to_string());
-            }
+        if let Some(f) = file {
+            push_once(&mut named.files, f);
         }
     }
     named
+}
+
+/// `value` appended to `list` unless it is there already.
+fn push_once(list: &mut Vec<String>, value: &str) {
+    if !list.iter().any(|g| g == value) {
+        list.push(value.to_string());
+    }
 }
 
 /// The values given on the command line to the arguments of `cmd` (and of the subcommand

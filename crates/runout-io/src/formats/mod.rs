@@ -182,8 +182,14 @@ pub fn open_recording(
 }
 
 /// Whether `path` names something that can be read only once, in order (a pipe, a FIFO, a
-/// device): neither a regular file nor a folder.
-fn is_stream(path: &Path) -> bool {
+/// device): neither a regular file nor a folder. Such a path must be opened once only: a second
+/// reader would take bytes from the first.
+///
+/// ```
+/// assert!(!runout_io::formats::is_stream(std::path::Path::new("Cargo.toml")));
+/// assert!(!runout_io::formats::is_stream(std::path::Path::new("no such file")));
+/// ```
+pub fn is_stream(path: &Path) -> bool {
     std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
