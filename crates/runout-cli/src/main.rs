@@ -134,7 +134,7 @@ fn main() -> ExitCode {
         Ok(()) if exit::is_not_identified() => ExitCode::from(exit::NOT_IDENTIFIED),
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", error_message(&e));
+            progress::to_stderr(&format!("error: {}", error_message(&e)));
             ExitCode::from(exit::INPUT_ERROR)
         }
     }

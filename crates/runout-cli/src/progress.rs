@@ -20,8 +20,16 @@ pub fn quiet() -> bool {
 /// A warning on stderr, unless `--quiet` (the report keeps it either way).
 pub fn warn(message: &str) {
     if !quiet() {
-        eprintln!("warning: {message}");
+        to_stderr(&format!("warning: {message}"));
     }
+}
+
+/// One line on stderr. A stderr that cannot be written (a reader that closed it, as with
+/// `2>&1 | head -1`) is ignored: there is nobody left to tell, and `eprintln!` would panic
+/// (exit 101) instead of ending with the command's own status.
+pub fn to_stderr(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
 }
 
 /// A spinner on stderr for a job without a byte count (hidden when stderr is not a terminal or

@@ -556,6 +556,41 @@ fn broken_pipe_ends_quietly_on_every_command_that_prints() {
     }
 }
 
+/// An error or a warning for a stderr whose reader is gone (as with `2>&1 | head -1` after the
+/// first line): the command ends with its own status — 1 for the error — not a panic (status
+/// 101: `eprintln!` panics when it cannot write).
+#[test]
+fn a_closed_stderr_keeps_the_commands_status() {
+    use std::process::{Command as StdCommand, Stdio};
+    let e = |p: &str| example(p).display().to_string();
+    let run = |args: &[String]| {
+        let mut child = StdCommand::new(assert_cmd::cargo::cargo_bin("runout"))
+            .args(args)
+            .env("RUST_BACKTRACE", "0")
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stderr.take());
+        child.wait().unwrap().code()
+    };
+    let rate = |v: &str| {
+        vec![
+            "identify".to_string(),
+            e("identify/cut_fz0.05.txt"),
+            e("identify/cut_fz0.08.txt"),
+            "--config".into(),
+            e("identify/cut.toml"),
+            format!("--sample-rate-hz={v}"),
+        ]
+    };
+    // an error (its message and the help pointer after it)
+    assert_eq!(run(&rate("nan")), Some(1));
+    assert_eq!(run(&rate("-5")), Some(1));
+    // warnings, then the answer (the example's fit is identified)
+    assert_eq!(run(&rate("10000")), Some(0));
+}
+
 // ----------------------------------------------------------------------------------------------
 // item 5: non-finite numbers anywhere in a parsed file are errors naming where
 
