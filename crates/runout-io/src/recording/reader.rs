@@ -611,6 +611,39 @@ impl<R: BufRead> RecordingReader<R> {
         self.lines.bytes
     }
 
+    /// The line number (counted from 1) of data sample `sample` (0-based) of a text
+    /// recording, read on from here (serially); `None` for a binary format, or when that sample
+    /// was already read or the data end before it. For an error message that names a sample
+    /// found implausible after parsing, e.g. a force beyond any dynamometer's range (the
+    /// chunks carry no line numbers: blank lines make them differ from the rows').
+    ///
+    /// ```
+    /// use runout_io::recording::{ReadOptions, RecordingReader};
+    /// let text = "time_s,Fx_N\n0,1\n\n \n0.001,2\n0.002,3\n";
+    /// let open = || RecordingReader::from_reader(text.as_bytes(), "rec.csv", &ReadOptions::new());
+    /// assert_eq!(open()?.line_of_sample(0)?, Some(2));
+    /// assert_eq!(open()?.line_of_sample(2)?, Some(6)); // after two blank lines
+    /// assert_eq!(open()?.line_of_sample(3)?, None); // three samples only
+    /// # Ok::<(), runout_io::recording::RecordingError>(())
+    /// ```
+    pub fn line_of_sample(mut self, sample: u64) -> Result<Option<u64>> {
+        if self.binary.is_some() || sample < self.sample {
+            return Ok(None);
+        }
+        self.row_lines = Some(Vec::new());
+        let mut chunk = RecordingChunk::default();
+        loop {
+            let first = self.sample;
+            let rows = self.read_chunk(&mut chunk, DEFAULT_CHUNK_ROWS)?;
+            if rows == 0 {
+                return Ok(None);
+            }
+            if sample < first + rows as u64 {
+                return Ok(self.chunk_lines().get((sample - first) as usize).copied());
+            }
+        }
+    }
+
     /// Samples delivered so far.
     pub fn samples_read(&self) -> u64 {
         if let Some(b) = &self.binary {
@@ -1570,6 +1603,45 @@ mod tests {
             .to_string();
         assert!(e.contains("c.csv:3:2: `1\\r5`"), "{e}");
         assert!(!e.contains('\r'), "{e:?}");
+    }
+
+    /// [`RecordingReader::line_of_sample`] over 150 000 rows with blank lines (empty, blanks, a
+    /// lone `\r`) every few rows: the line of samples among the rows read ahead at open, at a
+    /// chunk's edges and at the end, against the lines the text was written with.
+    #[test]
+    fn the_line_of_a_sample_counts_blank_lines() {
+        let mut text = String::from("time_s,Fx_N\n");
+        let mut lines = Vec::new(); // line of each sample
+        let mut line = 1;
+        for i in 0..150_000u64 {
+            if i % 7 == 3 {
+                text.push_str(["\n", "  \n", "\r\n"][(i % 3) as usize]);
+                line += 1;
+            }
+            text.push_str(&format!("{},{}\n", i as f64 * 1e-4, i % 13));
+            line += 1;
+            lines.push(line);
+        }
+        let open =
+            || RecordingReader::from_bytes("t.csv", text.as_bytes(), &ReadOptions::new()).unwrap();
+        let last = lines.len() as u64 - 1;
+        for s in [
+            0, 1, 2, 3, 4, 999, 1000, 1001, 65_535, 65_536, 131_072, last,
+        ] {
+            assert_eq!(
+                open().line_of_sample(s).unwrap(),
+                Some(lines[s as usize]),
+                "sample {s}"
+            );
+        }
+        assert_eq!(open().line_of_sample(last + 1).unwrap(), None);
+        // from a reader that has read on: the samples behind it are not found
+        let mut r = open();
+        r.read_chunk(&mut RecordingChunk::default(), 10).unwrap();
+        assert_eq!(r.line_of_sample(5).unwrap(), None);
+        let mut r = open();
+        r.read_chunk(&mut RecordingChunk::default(), 10).unwrap();
+        assert_eq!(r.line_of_sample(10).unwrap(), Some(lines[10]));
     }
 
     /// [`parallel`] with jobs of `job_bytes`.

@@ -52,10 +52,10 @@ struct Channels {
     axes: ResolvedAxes,
     factors: Vec<f64>,
     pulse: Option<usize>,
-    /// The recording's name and, per workpiece axis, the index of its source channel and how
-    /// messages name it (for [`implausible_force`]).
+    /// The recording's name and, per workpiece axis, its source channel: index, how messages
+    /// name it, and its column in a text file (for [`implausible_force`]).
     file: String,
-    sources: [Option<(usize, String)>; 3],
+    sources: [Option<(usize, String, Option<usize>)>; 3],
 }
 
 fn channels(name: &str, info: &RecordingInfo, req: &RecordingsRequest) -> Result<Channels> {
@@ -104,7 +104,8 @@ fn channels(name: &str, info: &RecordingInfo, req: &RecordingsRequest) -> Result
         } else {
             String::new()
         };
-        Some((i, format!("channel `{}` ({unit}{column})", c.header)))
+        let name = format!("channel `{}` ({unit}{column})", c.header);
+        Some((i, name, text.then_some(c.column)))
     });
     Ok(Channels {
         mapping,
@@ -116,6 +117,47 @@ fn channels(name: &str, info: &RecordingInfo, req: &RecordingsRequest) -> Result
     })
 }
 
+/// A sample of pass 1 beyond [`MAX_PLAUSIBLE_FORCE_N`] ([`implausible_force`]); [`analyse`]
+/// adds the cell's line where the file can be read again ([`ImplausibleForce::located`]).
+#[derive(Debug)]
+struct ImplausibleForce {
+    file: String,
+    /// The sample (0-based) and, in a text file, the column of its cell.
+    sample: u64,
+    column: Option<usize>,
+    /// What is wrong, without the file's name.
+    detail: String,
+}
+
+impl std::fmt::Display for ImplausibleForce {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.file, self.detail)
+    }
+}
+
+impl std::error::Error for ImplausibleForce {}
+
+impl ImplausibleForce {
+    /// The error with the cell's place as the reader's errors give it (`file:line:column:`),
+    /// found by reading the text file `src` again up to the sample (an error path only); as it
+    /// is when the recording is binary, came from a pipe, or cannot be read again.
+    fn located(self, src: &Source, opts: &ReadOptions) -> anyhow::Error {
+        let line = match (self.column, src.as_path()) {
+            (Some(_), Some(p)) if !runout_io::formats::is_stream(p) => src
+                .open_recording(opts)
+                .ok()
+                .and_then(|r| r.line_of_sample(self.sample).ok().flatten()),
+            _ => None,
+        };
+        match (line, self.column) {
+            (Some(line), Some(column)) => {
+                anyhow::anyhow!("{}:{line}:{column}: {}", self.file, self.detail)
+            }
+            _ => self.into(),
+        }
+    }
+}
+
 /// The error for a chunk whose workpiece axis `k` (forces `v`, N) holds a sample beyond
 /// [`MAX_PLAUSIBLE_FORCE_N`]: the first such sample by its number and time, and the cell of its
 /// source channel as the file has it.
@@ -125,19 +167,25 @@ fn implausible_force(ch: &Channels, chunk: &RecordingChunk, k: usize, v: &[f64])
         .position(|x| x.abs() > MAX_PLAUSIBLE_FORCE_N)
         .unwrap_or(0);
     let axis = ["x", "y", "z"][k];
-    let source = match &ch.sources[k] {
-        Some((c, name)) => format!("{name} reads {:e}", chunk.channel(*c)[i]),
-        None => format!("workpiece {axis} is {:e} N", v[i]),
+    let (source, column) = match &ch.sources[k] {
+        Some((c, name, column)) => (format!("{name} reads {:e}", chunk.channel(*c)[i]), *column),
+        None => (format!("workpiece {axis} is {:e} N", v[i]), None),
     };
-    anyhow::anyhow!(
-        "{}: sample {} (counted from 1; t = {} s): {source}, a force of {:e} N on workpiece {axis} — not a \
-         measured force (more than {MAX_PLAUSIBLE_FORCE_N:e} N, beyond any dynamometer's range); \
-         check that cell",
-        ch.file,
-        chunk.first_sample + i as u64 + 1,
-        chunk.time_s[i],
-        v[i].abs()
-    )
+    let sample = chunk.first_sample + i as u64;
+    ImplausibleForce {
+        file: ch.file.clone(),
+        sample,
+        column,
+        detail: format!(
+            "sample {} (counted from 1; t = {} s): {source}, a force of {:e} N on workpiece {axis} — \
+             not a measured force (more than {MAX_PLAUSIBLE_FORCE_N:e} N, beyond any dynamometer's \
+             range); check that cell",
+            sample + 1,
+            chunk.time_s[i],
+            v[i].abs()
+        ),
+    }
+    .into()
 }
 
 fn signal_config(
@@ -194,6 +242,10 @@ pub(super) fn analyse(
         } else {
             replay(&mut spill, has_z, progress, sink)
         }
+    })
+    .map_err(|e| match e.downcast::<ImplausibleForce>() {
+        Ok(f) => f.located(src, &opts),
+        Err(e) => e,
     })?;
     progress.end();
     let reader_warnings = reader.warnings().to_vec();
