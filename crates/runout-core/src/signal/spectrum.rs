@@ -33,6 +33,9 @@ pub(crate) struct Welch {
     frames: usize,
     /// Frames started (transformed or skipped).
     seen: usize,
+    /// `transformed(seen)`, kept with `seen` (issue 18: computed per sample, its remainder was
+    /// a division per sample on pass 1's main thread).
+    transforming: bool,
     /// Samples of the current frame when it is skipped.
     skipped_fill: usize,
 }
@@ -95,6 +98,7 @@ impl Welch {
             window: hann(frame),
             frames: 0,
             seen: 0,
+            transforming: transformed(0),
             skipped_fill: 0,
         }
     }
@@ -102,11 +106,11 @@ impl Welch {
     /// Add one sample of F_x, F_y.
     #[inline]
     pub fn push(&mut self, fx: f64, fy: f64) {
-        if !transformed(self.seen) {
+        if !self.transforming {
             self.skipped_fill += 1;
             if self.skipped_fill == self.frame {
                 self.skipped_fill = 0;
-                self.seen += 1;
+                self.next_frame();
             }
             return;
         }
@@ -115,8 +119,14 @@ impl Welch {
         if self.buf[0].len() == self.frame {
             self.transform();
             self.frames += 1;
-            self.seen += 1;
+            self.next_frame();
         }
+    }
+
+    /// The next frame starts.
+    fn next_frame(&mut self) {
+        self.seen += 1;
+        self.transforming = transformed(self.seen);
     }
 
     fn transform(&mut self) {
