@@ -424,11 +424,7 @@ impl SyncAverager {
                 *vz = a[2] + w * (b[2] - a[2]);
             }
         }
-        pulp::Arch::new().dispatch(Modulus {
-            x: sx,
-            y: sy,
-            out: sxy,
-        });
+        ForceComponent::Fxy.of_each(sx, sy, None, sxy);
         self.acc.push(&self.scratch);
         let ci = self.component.index();
         let wave = &self.scratch[ci * m..(ci + 1) * m];
@@ -509,27 +505,6 @@ impl SyncAverager {
             },
             tooth_peaks,
         })
-    }
-}
-
-/// |F_xy| = √(F_x² + F_y²) of a resampled revolution's bins ([`ForceComponent::Fxy`]), in a
-/// loop of its own compiled for the detected instruction set, so that the roots are taken
-/// several per instruction. Inside the resampling loop, one by one, they were ≈ 45 % of pass 3
-/// on this project's AMD EPYC (Zen 3) build machine (issue 18). A square root is correctly
-/// rounded in either form: the same bits.
-struct Modulus<'a> {
-    x: &'a [f64],
-    y: &'a [f64],
-    out: &'a mut [f64],
-}
-
-impl pulp::WithSimd for Modulus<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        for ((o, &x), &y) in self.out.iter_mut().zip(self.x).zip(self.y) {
-            *o = ForceComponent::Fxy.of([x, y, 0.0]);
-        }
     }
 }
 

@@ -174,6 +174,8 @@ pub struct PhaseTracker {
     resolution_hz: f64,
     component: ForceComponent,
     mode: Mode,
+    /// The component of each sample of the chunk being fed.
+    values: Vec<f64>,
 }
 
 impl PhaseTracker {
@@ -220,6 +222,7 @@ impl PhaseTracker {
             resolution_hz: scan.tooth_passing.resolution_hz,
             component: cfg.peak_component,
             mode,
+            values: Vec::new(),
         })
     }
 
@@ -257,7 +260,9 @@ impl PhaseTracker {
                 knots,
             } => {
                 let dt = 1.0 / fs;
-                let component = self.component;
+                let values = &mut self.values;
+                values.resize(c.len(), 0.0);
+                self.component.of_each(c.fx, c.fy, c.fz, values);
                 let rel_of = |i: usize| (start + i as u64) as f64 * dt - from;
                 let block_of = |rel: f64| (rel * *rev_s).floor() as u64;
                 let n = c.len();
@@ -295,9 +300,8 @@ impl PhaseTracker {
                             hi = mid;
                         }
                     }
-                    for j in i..lo {
+                    for (j, &x) in values.iter().enumerate().take(lo).skip(i) {
                         let rel = rel_of(j);
-                        let x = component.of(c.force(j));
                         acc.0 += x * ph.0;
                         acc.1 += x * ph.1;
                         *tsum += rel;
