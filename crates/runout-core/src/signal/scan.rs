@@ -56,11 +56,8 @@ impl SpindleScan {
     pub fn push(&mut self, c: SignalChunk) -> Result<(), SignalError> {
         self.guard
             .check(&c, self.cfg.sample_rate_hz, self.cfg.pulse.is_some())?;
-        for i in 0..c.len() {
-            let f = c.force(i);
-            self.welch.push(f[0], f[1]);
-            self.envelope.push(f);
-        }
+        self.welch.push_all(c.fx, c.fy);
+        self.envelope.push_all(c.fx, c.fy, c.fz);
         if let Some(p) = c.pulse {
             p.iter().for_each(|&v| self.pulse.push(v));
         }

@@ -103,8 +103,36 @@ impl Welch {
         }
     }
 
-    /// Add one sample of F_x, F_y.
-    #[inline]
+    /// Add samples of F_x, F_y: [`Welch::push`] sample by sample, a frame's run at a time
+    /// (copied into the frame, or counted when the frame is skipped).
+    pub fn push_all(&mut self, fx: &[f64], fy: &[f64]) {
+        let n = fx.len().min(fy.len());
+        let mut i = 0;
+        while i < n {
+            if !self.transforming {
+                let take = (self.frame - self.skipped_fill).min(n - i);
+                self.skipped_fill += take;
+                i += take;
+                if self.skipped_fill == self.frame {
+                    self.skipped_fill = 0;
+                    self.next_frame();
+                }
+                continue;
+            }
+            let take = (self.frame - self.buf[0].len()).min(n - i);
+            self.buf[0].extend_from_slice(&fx[i..i + take]);
+            self.buf[1].extend_from_slice(&fy[i..i + take]);
+            i += take;
+            if self.buf[0].len() == self.frame {
+                self.transform();
+                self.frames += 1;
+                self.next_frame();
+            }
+        }
+    }
+
+    /// Add one sample of F_x, F_y: the reference for [`Welch::push_all`].
+    #[cfg(test)]
     pub fn push(&mut self, fx: f64, fy: f64) {
         if !self.transforming {
             self.skipped_fill += 1;
@@ -257,6 +285,35 @@ impl Welch {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`Welch::push_all`] over chunks of any sizes gives the spectrum, bit for bit, of
+    /// [`Welch::push`] sample by sample: 300 frames of 256 samples, so that frames are both
+    /// transformed and skipped, and a partial frame at the end.
+    #[test]
+    fn push_all_equals_push_sample_by_sample() {
+        let n = 300 * 256 + 100;
+        let fx: Vec<f64> = (0..n)
+            .map(|i| (i as f64 * 0.37).sin() + (i % 7) as f64)
+            .collect();
+        let fy: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).cos() * 3.0).collect();
+        let mut one = Welch::new(10_000.0, 30.0);
+        for i in 0..n {
+            one.push(fx[i], fy[i]);
+        }
+        let mut all = Welch::new(10_000.0, 30.0);
+        let (mut at, mut k) = (0, 0usize);
+        while at < n {
+            // chunk sizes 1, 2, … 700, then again: across frame edges in every phase
+            let end = (at + 1 + k % 700).min(n);
+            all.push_all(&fx[at..end], &fy[at..end]);
+            (at, k) = (end, k + 37);
+        }
+        assert_eq!(one.frame, 256);
+        assert_eq!((one.finish(), one.seen), (all.finish(), all.seen));
+        assert!(one.frames > 64 && one.frames < 300, "{}", one.frames);
+        let bits = |w: &Welch| w.psd.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&one), bits(&all));
+    }
 
     #[test]
     fn finds_a_pure_tone_within_a_small_fraction_of_a_bin() {
