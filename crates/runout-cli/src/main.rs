@@ -1,5 +1,8 @@
 //! `runout`: command-line program for cutter runout in milling. A thin layer over `runout-core`
 //! (model and methods) and `runout-io` (formats): parse arguments, read, call, write.
+// The flags' doc comments are clap's `--help` text, written for a terminal: `[[case]]`,
+// `x,y[,z]` and `h_<model>_mm` are what the user types or reads, not rustdoc links or HTML.
+#![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 
 mod cmd;
 mod exit;
