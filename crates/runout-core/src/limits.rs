@@ -15,6 +15,9 @@
 //! | Monte-Carlo draws | ..= 100 000 | [`MAX_DRAWS`] |
 //! | coordinates in files (mm) | \|x\| ≤ 100 000 | [`MAX_COORDINATE_MM`] |
 //! | cutter, shank, edge diameter (mm) | [0.001, 2 000] | [`MIN_DIAMETER_MM`], [`MAX_DIAMETER_MM`] |
+//! | shank modulus E (GPa) | [1, 2 000] | [`MIN_MODULUS_GPA`], [`MAX_MODULUS_GPA`] |
+//! | holder rotational stiffness k_θ (N·m/rad) | [1, 10¹²] | [`MIN_HOLDER_STIFFNESS_NM_PER_RAD`] |
+//! | gap between the shank's two sensors (mm) | ≥ 0.001 | [`MIN_SENSOR_GAP_MM`] |
 //! | feed per tooth f_z (mm) | (0, 10] | [`MAX_FZ_MM`] |
 //! | feed rate (mm/min) | [0.001, 1 000 000] | [`MIN_FEED_MM_MIN`], [`MAX_FEED_MM_MIN`] |
 //! | depths a_p, a_e (mm) | a_p in [0.001, 1 000], a_e in (0, D] | [`MIN_DEPTH_MM`], [`MAX_DEPTH_MM`] |
@@ -63,6 +66,19 @@ pub const MAX_COORDINATE_MM: f64 = 1.0e5;
 pub const MIN_DIAMETER_MM: f64 = 1.0e-3;
 /// Largest cutter diameter (mm).
 pub const MAX_DIAMETER_MM: f64 = 2_000.0;
+/// Smallest Young's modulus of a tool shank (GPa): tool materials run from ≈ 70 (aluminium
+/// extensions) to ≈ 1 050 (diamond); 1 GPa keeps every beam formula far from underflow.
+pub const MIN_MODULUS_GPA: f64 = 1.0;
+/// Largest Young's modulus of a tool shank (GPa).
+pub const MAX_MODULUS_GPA: f64 = 2_000.0;
+/// Smallest rotational stiffness of a tool holder (N·m/rad): real holders are 10⁴–10⁷; below
+/// 1 N·m/rad the holder term x·a/k_θ of the compliance overflows for subnormal inputs.
+pub const MIN_HOLDER_STIFFNESS_NM_PER_RAD: f64 = 1.0;
+/// Largest rotational stiffness of a tool holder (N·m/rad); stiffer is a rigid clamp.
+pub const MAX_HOLDER_STIFFNESS_NM_PER_RAD: f64 = 1.0e12;
+/// Smallest height difference between the shank's two displacement sensors (mm): 1 µm, as the
+/// smallest diameter (below it l_II² − l_I² underflows and K_δ comes out infinite).
+pub const MIN_SENSOR_GAP_MM: f64 = 1.0e-3;
 /// Largest feed per tooth f_z (mm).
 pub const MAX_FZ_MM: f64 = 10.0;
 /// Smallest feed rate (mm/min) of a toolpath move.

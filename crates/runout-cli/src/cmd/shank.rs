@@ -38,7 +38,7 @@ enum Sub {
 /// Flags of `runout shank stiffness`.
 #[derive(clap::Args, Debug)]
 pub struct StiffnessArgs {
-    /// Young's modulus E of the shank (GPa).
+    /// Young's modulus E of the shank (GPa, 1–2000).
     #[arg(long, allow_hyphen_values = true)]
     modulus_gpa: String,
     /// Shank diameter d (mm).
@@ -50,13 +50,13 @@ pub struct StiffnessArgs {
     /// Height of sensor I from the holder face l_I (mm).
     #[arg(long, allow_hyphen_values = true)]
     l1_mm: String,
-    /// Height of sensor II from the holder face l_II (mm), l_I < l_II ≤ l_tool.
+    /// Height of sensor II from the holder face l_II (mm), l_I + 0.001 ≤ l_II ≤ l_tool.
     #[arg(long, allow_hyphen_values = true)]
     l2_mm: String,
     /// Load at mid axial depth, l_tool − a_p/2: the axial depth of cut a_p (mm).
     #[arg(long, allow_hyphen_values = true)]
     ap_mm: Option<String>,
-    /// Rotational stiffness of the tool holder k_θ (N·m/rad); default rigid.
+    /// Rotational stiffness of the tool holder k_θ (N·m/rad, 1–1e12); default rigid.
     #[arg(long, allow_hyphen_values = true)]
     holder_stiffness_nm_per_rad: Option<String>,
     /// Density of the tool (kg/m³) for its first bending mode; default 14500 (carbide) if
@@ -196,10 +196,29 @@ fn stiffness(a: StiffnessArgs) -> Result<()> {
             })
             .transpose()?,
     };
-    let report = shank::stiffness(&req)?;
+    let report = shank::stiffness(&req).map_err(stiffness_flag_error)?;
     emit(a.json.as_deref(), &report, || {
         render::stiffness_text(&report)
     })
+}
+
+/// A beam parameter out of range, named by its flag as every other flag error is
+/// (`--l2-mm (key \`l2_mm\`): expected …`); the load point comes from `--ap-mm`.
+fn stiffness_flag_error(e: anyhow::Error) -> anyhow::Error {
+    let Some(p) = e.downcast_ref::<runout_core::ParamError>() else {
+        return e;
+    };
+    let flag = match p.param.as_str() {
+        "load_point_mm" => "--ap-mm".to_string(),
+        "shank" => return e,
+        key => format!("--{}", key.replace('_', "-").to_lowercase()),
+    };
+    anyhow::anyhow!(
+        "{flag} (key `{}`): expected {}, got {}",
+        p.param,
+        p.expected,
+        p.got
+    )
 }
 
 fn force(a: ForceArgs) -> Result<()> {

@@ -383,6 +383,49 @@ fn dynoware_input_with_decimal_commas_gives_the_same_force() {
     }
 }
 
+/// `shank stiffness` with a subnormal or out-of-range beam: exit 1 and the flag, its range and
+/// unit named (a 1.29e-309 N·m/rad holder printed `K_delta = NaN N/um` with exit 0, and the
+/// errors named the library's `holder_rotational_stiffness_Nmm_per_rad` in N·mm/rad).
+#[test]
+fn stiffness_flags_out_of_range_are_named() {
+    let base = [
+        "shank",
+        "stiffness",
+        "--diameter-mm",
+        "8",
+        "--tool-length-mm",
+        "65",
+    ];
+    for (args, want) in [
+        (
+            &["--modulus-gpa", "210", "--l1-mm", "10", "--l2-mm", "30", "--holder-stiffness-nm-per-rad", "1.291403585584835e-309"][..],
+            "--holder-stiffness-nm-per-rad (key `holder_stiffness_Nm_per_rad`): expected a number in [1, 1000000000000] N·m/rad, got 1.291403585584835e-309",
+        ),
+        (
+            &["--modulus-gpa", "210", "--l1-mm", "10", "--l2-mm", "30", "--holder-stiffness-nm-per-rad", "-1"],
+            "--holder-stiffness-nm-per-rad (key `holder_stiffness_Nm_per_rad`): expected a number in [1, 1000000000000] N·m/rad, got -1",
+        ),
+        (
+            &["--modulus-gpa", "5e-324", "--l1-mm", "10", "--l2-mm", "30"],
+            "--modulus-gpa (key `modulus_gpa`): expected a number in [1, 2000] GPa, got 5e-324",
+        ),
+        (
+            &["--modulus-gpa", "210", "--l1-mm", "0", "--l2-mm", "1e-200"],
+            "--l2-mm (key `l2_mm`): expected sensors at least 0.001 mm apart",
+        ),
+        (
+            &["--modulus-gpa", "210", "--l1-mm", "10", "--l2-mm", "30", "--ap-mm", "200"],
+            "--ap-mm (key `load_point_mm`): expected a load point on the tool beyond sensor I",
+        ),
+    ] {
+        let out = runout().args(base).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.starts_with(&format!("error: {want}")), "{args:?}: {err}");
+        assert!(out.stdout.is_empty() && !err.contains("NaN"), "{args:?}");
+    }
+}
+
 #[test]
 fn bad_inputs_give_clear_errors() {
     let dir = tempfile::tempdir().unwrap();

@@ -72,7 +72,11 @@ impl Sampling {
                     "at most {} samples in one simulation (revolutions·360/step_deg)",
                     Self::MAX_SAMPLES
                 ),
-                format!("{revolutions} revolutions at {step_deg}° = {samples:.3e} samples"),
+                format!(
+                    "{} revolutions at {}° = {samples:.3e} samples",
+                    crate::limits::show(revolutions),
+                    crate::limits::show(step_deg)
+                ),
             ));
         }
         Ok(Sampling {

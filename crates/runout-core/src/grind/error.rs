@@ -82,7 +82,7 @@ pub enum GrindError {
         angle_deg: f64,
     },
     /// A touched point far from the nominal surface: the probe missed or hit debris.
-    #[error("row {row}: measured radius {radius_mm:.6} mm is {distance_um:.1} µm from the nominal radius {nominal_mm:.6} mm at u = {u_mm} mm (limit {limit_um} µm: probe miss?)")]
+    #[error("row {row}: measured radius {radius_mm:.6} mm is {distance_um:.1} µm from the nominal radius {nominal_mm:.6} mm at u = {u_mm} mm (limit {limit} µm: probe miss?)", limit = crate::limits::show(*.limit_um))]
     ProbeMiss {
         /// Row.
         row: usize,

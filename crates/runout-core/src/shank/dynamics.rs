@@ -404,8 +404,12 @@ mod tests {
         let ei = beam.modulus_n_per_mm2 * beam.second_moment_mm4();
         let stiff = beam.with_holder_stiffness(1e6 * ei / 65.0).unwrap();
         assert!((stiff.first_mode_beta_l() - 1.875104).abs() < 1e-5);
+        // (κ = k_θ·L/EI = 1e-3 on a 40 mm shank: k_θ = 400 N·m/rad, above the 1 N·m/rad floor
+        // of `limits`, which the 8 mm shank's 0.65 N·m/rad is not)
         let kappa = 1e-3;
-        let soft = beam.with_holder_stiffness(kappa * ei / 65.0).unwrap();
+        let thick = ShankBeam::new(210.0, 40.0, 65.0, 10.0, 30.0).unwrap();
+        let ei = thick.modulus_n_per_mm2 * thick.second_moment_mm4();
+        let soft = thick.with_holder_stiffness(kappa * ei / 65.0).unwrap();
         let want = (3.0 * kappa).powf(0.25);
         assert!(
             (soft.first_mode_beta_l() / want - 1.0).abs() < 1e-3,

@@ -13,6 +13,10 @@
 //! two worked examples, methods.md §7).
 
 use crate::error::{positive, ParamError};
+use crate::limits::{
+    show, within, MAX_HOLDER_STIFFNESS_NM_PER_RAD, MAX_MODULUS_GPA,
+    MIN_HOLDER_STIFFNESS_NM_PER_RAD, MIN_MODULUS_GPA, MIN_SENSOR_GAP_MM,
+};
 
 /// Where the resultant cutting force acts on the tool.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,7 +65,13 @@ impl ShankBeam {
         l2_mm: f64,
     ) -> Result<Self, ParamError> {
         let beam = ShankBeam {
-            modulus_n_per_mm2: positive("modulus_gpa", modulus_gpa)? * 1e3,
+            modulus_n_per_mm2: within(
+                "modulus_gpa",
+                modulus_gpa,
+                MIN_MODULUS_GPA,
+                MAX_MODULUS_GPA,
+                "GPa",
+            )? * 1e3,
             diameter_mm: crate::limits::diameter("diameter_mm", diameter_mm)?,
             tool_length_mm: positive("tool_length_mm", tool_length_mm)?,
             l1_mm,
@@ -81,13 +91,19 @@ impl ShankBeam {
         Ok(self)
     }
 
-    /// The same shank in a holder of rotational stiffness k_θ (N·mm/rad).
+    /// The same shank in a holder of rotational stiffness k_θ (N·mm/rad). Checked in the unit
+    /// users give it, N·m/rad (`holder_stiffness_Nm_per_rad`, in
+    /// [[`MIN_HOLDER_STIFFNESS_NM_PER_RAD`], [`MAX_HOLDER_STIFFNESS_NM_PER_RAD`]]).
     pub fn with_holder_stiffness(mut self, k_theta_nmm_per_rad: f64) -> Result<Self, ParamError> {
-        positive(
-            "holder_rotational_stiffness_Nmm_per_rad",
-            k_theta_nmm_per_rad,
+        within(
+            "holder_stiffness_Nm_per_rad",
+            k_theta_nmm_per_rad / 1e3,
+            MIN_HOLDER_STIFFNESS_NM_PER_RAD,
+            MAX_HOLDER_STIFFNESS_NM_PER_RAD,
+            "N·m/rad",
         )?;
         self.holder_rotational_stiffness_nmm_per_rad = Some(k_theta_nmm_per_rad);
+        self.validate()?;
         Ok(self)
     }
 
@@ -100,24 +116,35 @@ impl ShankBeam {
                 l1,
             ));
         }
+        let (l1s, lts) = (show(l1), show(lt));
         if !l2.is_finite() || l2 == l1 {
             return Err(ParamError::new(
                 "l2_mm",
-                format!("a height different from l1_mm = {l1} (sensors at equal heights measure no relative deflection)"),
+                format!("a height different from l1_mm = {l1s} (sensors at equal heights measure no relative deflection)"),
                 l2,
             ));
         }
         if l2 < l1 {
             return Err(ParamError::new(
                 "l2_mm",
-                format!("sensor II farther from the holder than sensor I (l2_mm > l1_mm = {l1})"),
+                format!("sensor II farther from the holder than sensor I (l2_mm > l1_mm = {l1s})"),
+                l2,
+            ));
+        }
+        if l2 - l1 < MIN_SENSOR_GAP_MM {
+            return Err(ParamError::new(
+                "l2_mm",
+                format!(
+                    "sensors at least {MIN_SENSOR_GAP_MM} mm apart (l2_mm ≥ l1_mm + {MIN_SENSOR_GAP_MM} = {})",
+                    show(l1 + MIN_SENSOR_GAP_MM)
+                ),
                 l2,
             ));
         }
         if l2 > lt {
             return Err(ParamError::new(
                 "l2_mm",
-                format!("a height on the tool, ≤ tool_length_mm = {lt}"),
+                format!("a height on the tool, ≤ tool_length_mm = {lts}"),
                 l2,
             ));
         }
@@ -128,9 +155,19 @@ impl ShankBeam {
             return Err(ParamError::new(
                 "load_point_mm",
                 format!(
-                    "a load point on the tool beyond sensor I, l1_mm = {l1} < a ≤ tool_length_mm = {lt}"
+                    "a load point on the tool beyond sensor I, l1_mm = {l1s} < a ≤ tool_length_mm = {lts}"
                 ),
                 a,
+            ));
+        }
+        // every input in range keeps K_δ finite and positive; this guards the combinations
+        let k = self.stiffness_n_per_mm();
+        if !(k.is_finite() && k > 0.0) {
+            return Err(ParamError::new(
+                "shank",
+                "a beam whose stiffness K_δ = F/(δ_II − δ_I) is a finite number > 0 N/mm \
+                 (check modulus_gpa, diameter_mm, l1_mm, l2_mm, tool_length_mm)",
+                k,
             ));
         }
         Ok(())
@@ -171,9 +208,18 @@ impl ShankBeam {
         Self::bending_shape_mm3(x_mm, a) / (6.0 * ei) + rot
     }
 
-    /// K_δ = F/(δ_II − δ_I), N/mm (methods.md §3.1).
+    /// K_δ = F/(δ_II − δ_I), N/mm (methods.md §3.1). The holder terms of the two sensors are
+    /// subtracted as one product, (l_II − l_I)·a/k_θ: for a very soft holder each alone could
+    /// overflow, and ∞ − ∞ is NaN.
     pub fn stiffness_n_per_mm(&self) -> f64 {
-        1.0 / (self.compliance_at_mm_per_n(self.l2_mm) - self.compliance_at_mm_per_n(self.l1_mm))
+        let (l1, l2, a) = (self.l1_mm, self.l2_mm, self.load_distance_mm());
+        let ei = self.modulus_n_per_mm2 * self.second_moment_mm4();
+        let bending =
+            (Self::bending_shape_mm3(l2, a) - Self::bending_shape_mm3(l1, a)) / (6.0 * ei);
+        let holder = self
+            .holder_rotational_stiffness_nmm_per_rad
+            .map_or(0.0, |k| (l2 - l1) * a / k);
+        1.0 / (bending + holder)
     }
 
     /// K_δ in N/µm.

@@ -241,7 +241,7 @@ impl SignalConfig {
                 return Err(ParamError::new(
                     "from_s/to_s",
                     "finite times with 0 <= from_s < to_s",
-                    format!("{a}..{b}"),
+                    format!("{}..{}", crate::limits::show(a), crate::limits::show(b)),
                 )
                 .into());
             }

@@ -95,6 +95,63 @@ fn bad_geometry_is_rejected_with_the_parameter_named() {
     assert_eq!(e.param, "load_point_mm");
 }
 
+/// Found by a stress run of the CLI's flag properties: a subnormal holder stiffness made each
+/// sensor's holder term overflow and K_δ = ∞ − ∞ = NaN (exit 0, `K_delta = NaN N/um`); a
+/// subnormal modulus gave NaN too, and a sensor gap of 1e-200 mm an infinite K_δ. Now each is
+/// refused, naming the key, and every accepted beam has a finite K_δ > 0.
+#[test]
+fn subnormal_and_degenerate_beams_are_refused() {
+    for k in [5e-324, 1.29e-309, 1e-20, 0.5, -1.0, f64::NAN, 2e12] {
+        let e = example1().with_holder_stiffness(k * 1e3).unwrap_err();
+        assert_eq!(e.param, "holder_stiffness_Nm_per_rad", "{k}: {e}");
+        assert!(e.expected.contains("N·m/rad"), "{e}");
+    }
+    for m in [5e-324, 1e-320, 0.5, 3000.0] {
+        let e = ShankBeam::new(m, 8.0, 65.0, 10.0, 30.0).unwrap_err();
+        assert_eq!(e.param, "modulus_gpa", "{m}: {e}");
+    }
+    for l2 in [1e-200, 2.2e-308, 1e-100, 5e-4] {
+        let e = ShankBeam::new(210.0, 8.0, 65.0, 0.0, l2).unwrap_err();
+        assert_eq!(e.param, "l2_mm", "{l2}: {e}");
+        assert!(e.expected.contains("0.001 mm apart"), "{e}");
+        assert!(e.to_string().len() < 200, "{e}");
+    }
+    // the limits themselves are accepted, with a finite K_δ
+    let soft = example1().with_holder_stiffness(1e3).unwrap();
+    let k = soft.stiffness_n_per_mm();
+    assert!(k.is_finite() && k > 0.0, "{k}");
+    let close = ShankBeam::new(210.0, 8.0, 65.0, 0.0, 0.001).unwrap();
+    assert!(close.stiffness_n_per_mm().is_finite());
+}
+
+proptest! {
+    /// Every beam the constructors accept has a finite K_δ > 0 and a finite first bending mode:
+    /// inputs over the accepted ranges (moduli 1–2000 GPa, diameters 1 µm–2 m, sensors from the
+    /// holder face to the tip at least 1 µm apart, holders 1–1e12 N·m/rad, log-uniform).
+    #[test]
+    fn every_accepted_beam_has_a_finite_positive_stiffness(
+        log_e in 0.0f64..3.3,
+        log_d in -3.0f64..3.3,
+        log_l in -2.0f64..5.0,
+        u1 in 0.0f64..1.0,
+        u2 in 0.0f64..1.0,
+        log_k in prop::option::of(0.0f64..12.0),
+    ) {
+        let lt = 10f64.powf(log_l);
+        let l1 = u1 * lt;
+        let l2 = l1 + 1e-3 + u2 * (lt - l1);
+        let beam = ShankBeam::new(10f64.powf(log_e), 10f64.powf(log_d), lt, l1, l2);
+        let Ok(mut beam) = beam else { return Ok(()) }; // (l2 beyond the tip: refused)
+        if let Some(lk) = log_k {
+            beam = beam.with_holder_stiffness(10f64.powf(lk) * 1e3).unwrap();
+        }
+        let k = beam.stiffness_n_per_mm();
+        prop_assert!(k.is_finite() && k > 0.0, "{beam:?}: {k}");
+        let f1 = beam.first_bending_mode_hz(7850.0).unwrap();
+        prop_assert!(f1.is_finite() && f1 > 0.0, "{beam:?}: {f1}");
+    }
+}
+
 /// Δ for a load F at a on the true shank (bending scale s, holder k_θ).
 fn true_delta(beam: &ShankBeam, s: f64, k_theta: f64, f: f64, a: f64) -> f64 {
     let ei = beam.modulus_n_per_mm2 * beam.second_moment_mm4();

@@ -253,7 +253,11 @@ pub fn resolve_identify(s: &Settings, recordings: usize) -> Result<IdentifyCase,
                         .unwrap_or("config")
                         .into(),
                     key: "from_s/to_s".into(),
-                    message: format!("expected 0 <= from_s < to_s, got {a} and {b}"),
+                    message: format!(
+                        "expected 0 <= from_s < to_s, got {} and {}",
+                        runout_core::limits::show(a),
+                        runout_core::limits::show(b)
+                    ),
                 });
             }
             Some((a, b))

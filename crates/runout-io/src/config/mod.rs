@@ -165,7 +165,10 @@ impl Settings {
                 Err(ConfigError::Key {
                     source_name: origin,
                     key: key.into(),
-                    message: format!("{v} is not a whole number >= 0"),
+                    message: format!(
+                        "{} is not a whole number >= 0",
+                        runout_core::limits::show(v)
+                    ),
                 })
             }
         }

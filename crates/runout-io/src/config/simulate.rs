@@ -267,8 +267,9 @@ pub fn resolve_cut(s: &Settings, cutter: &Cutter, fz: f64, ap: f64) -> Result<Cu
             source_name: s.origin("ap_mm").unwrap_or("config").into(),
             key: "ap_mm".into(),
             message: format!(
-                "expected an axial depth within the flute length {} mm, got {ap}",
-                cutter.flute_length()
+                "expected an axial depth within the flute length {} mm, got {}",
+                runout_core::limits::show(cutter.flute_length()),
+                runout_core::limits::show(ap)
             ),
         });
     }

@@ -766,11 +766,13 @@ fn collect(
             message: format!(
                 "no sample in the selected section [{}, {}] s; the signal's times run from {} s \
                  to {}{} s: choose --from-s/--to-s (s) inside them",
-                section.from_s.map_or("start".into(), |v| v.to_string()),
-                section.to_s.map_or("end".into(), |v| v.to_string()),
-                span.map_or(0.0, |s| s.0),
+                section
+                    .from_s
+                    .map_or("start".into(), runout_core::limits::show),
+                section.to_s.map_or("end".into(), runout_core::limits::show),
+                runout_core::limits::show(span.map_or(0.0, |s| s.0)),
                 if stopped_early { "at least " } else { "" },
-                span.map_or(0.0, |s| s.1),
+                runout_core::limits::show(span.map_or(0.0, |s| s.1)),
             ),
         });
     }

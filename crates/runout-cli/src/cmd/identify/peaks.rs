@@ -78,6 +78,7 @@ fn request(a: &Args) -> Result<PeaksRequest> {
     if let Some(t) = &a.teeth {
         let t = quantity(t, "teeth", Quantity::Dimensionless)?;
         if t != k as f64 {
+            let t = runout_core::limits::show(t);
             bail!("--teeth {t} but --peaks-N has {k} values (one peak per tooth expected)");
         }
     }
