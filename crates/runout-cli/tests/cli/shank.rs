@@ -468,6 +468,30 @@ fn bad_inputs_give_clear_errors() {
         err.contains("l2_mm") && err.contains("equal heights"),
         "{err}"
     );
+    // a subnormal holder stiffness: refused, with the file and key (it printed NaN forces)
+    let cfg = dir.path().join("holder.toml");
+    fs::write(
+        &cfg,
+        text.replace(
+            "modulus_gpa = 210",
+            "modulus_gpa = 210\nholder_stiffness_Nm_per_rad = 1e-310",
+        ),
+    )
+    .unwrap();
+    let out = runout()
+        .args(["shank", "force"])
+        .arg(&rec)
+        .arg("--config")
+        .arg(&cfg)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("holder.toml: [shank]")
+            && err.contains("`holder_stiffness_Nm_per_rad`: expected a number in [1, 1000000000000] N·m/rad, got 1e-310"),
+        "{err}"
+    );
     // unknown key
     let cfg = dir.path().join("typo.toml");
     fs::write(&cfg, text.replace("l2_mm", "l22_mm")).unwrap();

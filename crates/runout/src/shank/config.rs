@@ -54,7 +54,9 @@ pub(crate) fn load_config(config: &Source, rate: Option<f64>) -> Result<Resolved
             let Some(ap) = ap else {
                 bail!("{file}: load_point = \"mid-depth\" needs axial_depth_mm");
             };
-            beam = beam.with_load_point(LoadPoint::MidDepth { axial_depth_mm: ap })?;
+            beam = beam
+                .with_load_point(LoadPoint::MidDepth { axial_depth_mm: ap })
+                .with_context(|| format!("{file}: [shank]"))?;
         }
     }
     if let Some(k) = &b.holder_stiffness_nm_per_rad {
@@ -65,7 +67,9 @@ pub(crate) fn load_config(config: &Source, rate: Option<f64>) -> Result<Resolved
                     anyhow::anyhow!("{file}: holder_stiffness_Nm_per_rad = `{t}` is not a number")
                 }),
             })?;
-        beam = beam.with_holder_stiffness(k * 1e3)?;
+        beam = beam
+            .with_holder_stiffness(k * 1e3)
+            .with_context(|| format!("{file}: [shank]"))?;
     }
     let (stiffness, source) = match &b.stiffness_n_per_um {
         Some(v) => {
