@@ -426,6 +426,17 @@ fn stiffness_flags_out_of_range_are_named() {
     }
 }
 
+/// `runout shank force REC --config CFG`, its output whatever the status.
+fn force_with(rec: &Path, cfg: &Path) -> std::process::Output {
+    runout()
+        .args(["shank", "force"])
+        .arg(rec)
+        .arg("--config")
+        .arg(cfg)
+        .output()
+        .unwrap()
+}
+
 #[test]
 fn bad_inputs_give_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
@@ -440,13 +451,7 @@ fn bad_inputs_give_clear_errors() {
     .unwrap();
     let cfg = dir.path().join("missing.toml");
     fs::write(&cfg, text.replace("\"yII\"", "\"zII\"")).unwrap();
-    let out = runout()
-        .args(["shank", "force"])
-        .arg(&rec)
-        .arg("--config")
-        .arg(&cfg)
-        .output()
-        .unwrap();
+    let out = force_with(&rec, &cfg);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -456,13 +461,7 @@ fn bad_inputs_give_clear_errors() {
     // sensors at equal heights in the config
     let cfg = dir.path().join("equal.toml");
     fs::write(&cfg, text.replace("l2_mm = 30", "l2_mm = 10")).unwrap();
-    let out = runout()
-        .args(["shank", "force"])
-        .arg(&rec)
-        .arg("--config")
-        .arg(&cfg)
-        .output()
-        .unwrap();
+    let out = force_with(&rec, &cfg);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("l2_mm") && err.contains("equal heights"),
@@ -478,13 +477,7 @@ fn bad_inputs_give_clear_errors() {
         ),
     )
     .unwrap();
-    let out = runout()
-        .args(["shank", "force"])
-        .arg(&rec)
-        .arg("--config")
-        .arg(&cfg)
-        .output()
-        .unwrap();
+    let out = force_with(&rec, &cfg);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -495,13 +488,7 @@ fn bad_inputs_give_clear_errors() {
     // unknown key
     let cfg = dir.path().join("typo.toml");
     fs::write(&cfg, text.replace("l2_mm", "l22_mm")).unwrap();
-    let out = runout()
-        .args(["shank", "force"])
-        .arg(&rec)
-        .arg("--config")
-        .arg(&cfg)
-        .output()
-        .unwrap();
+    let out = force_with(&rec, &cfg);
     assert!(String::from_utf8_lossy(&out.stderr).contains("l22_mm"));
     // no air cut: the cut starts after 2 revolutions and never ends
     let (cols, _) = synthetic(2.0, 30.0, 0.0);
