@@ -107,6 +107,23 @@ impl ShankBeam {
         Ok(self)
     }
 
+    /// [`ShankBeam::with_holder_stiffness`] with k_θ in N·m/rad, the unit users give it: checked
+    /// before the conversion, so that an error shows the value as given (1e308 N·m/rad is
+    /// ∞ N·mm/rad).
+    pub fn with_holder_stiffness_nm_per_rad(
+        self,
+        k_theta_nm_per_rad: f64,
+    ) -> Result<Self, ParamError> {
+        within(
+            "holder_stiffness_Nm_per_rad",
+            k_theta_nm_per_rad,
+            MIN_HOLDER_STIFFNESS_NM_PER_RAD,
+            MAX_HOLDER_STIFFNESS_NM_PER_RAD,
+            "N·m/rad",
+        )?;
+        self.with_holder_stiffness(k_theta_nm_per_rad * 1e3)
+    }
+
     fn validate(&self) -> Result<(), ParamError> {
         let (l1, l2, lt) = (self.l1_mm, self.l2_mm, self.tool_length_mm);
         if !(l1.is_finite() && l1 >= 0.0) {

@@ -106,6 +106,11 @@ fn subnormal_and_degenerate_beams_are_refused() {
         assert_eq!(e.param, "holder_stiffness_Nm_per_rad", "{k}: {e}");
         assert!(e.expected.contains("N·m/rad"), "{e}");
     }
+    // given in N·m/rad: the value as given in the message, not its overflowed N·mm/rad
+    let e = example1()
+        .with_holder_stiffness_nm_per_rad(1e308)
+        .unwrap_err();
+    assert_eq!(e.got, "1e308", "{e}");
     for m in [5e-324, 1e-320, 0.5, 3000.0] {
         let e = ShankBeam::new(m, 8.0, 65.0, 10.0, 30.0).unwrap_err();
         assert_eq!(e.param, "modulus_gpa", "{m}: {e}");

@@ -68,7 +68,7 @@ pub(crate) fn load_config(config: &Source, rate: Option<f64>) -> Result<Resolved
                 }),
             })?;
         beam = beam
-            .with_holder_stiffness(k * 1e3)
+            .with_holder_stiffness_nm_per_rad(k)
             .with_context(|| format!("{file}: [shank]"))?;
     }
     let (stiffness, source) = match &b.stiffness_n_per_um {

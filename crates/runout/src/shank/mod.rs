@@ -88,7 +88,7 @@ pub fn stiffness(req: &StiffnessRequest) -> Result<StiffnessReport> {
         beam = beam.with_load_point(LoadPoint::MidDepth { axial_depth_mm: ap })?;
     }
     if let Some(k) = req.holder_stiffness_Nm_per_rad {
-        beam = beam.with_holder_stiffness(k * 1e3)?;
+        beam = beam.with_holder_stiffness_nm_per_rad(k)?;
     }
     let density = req.density_kg_per_m3.unwrap_or_else(|| {
         runout_core::shank::default_density_kg_per_m3(beam.modulus_n_per_mm2 / 1e3)
