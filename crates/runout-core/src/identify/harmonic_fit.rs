@@ -132,6 +132,17 @@ struct CaseData {
     free_angle: Option<usize>,
 }
 
+/// `f(m)` at every harmonic m that `used` marks, `zero` at the others.
+fn at_used<T: Clone>(used: &[bool], zero: T, f: impl Fn(usize) -> T) -> Vec<T> {
+    let mut t = vec![zero; used.len()];
+    for (m, &u) in used.iter().enumerate() {
+        if u {
+            t[m] = f(m);
+        }
+    }
+    t
+}
+
 /// Rigid-model harmonic k of the six coefficient-gradient columns (K order) for axis, from the
 /// basis harmonics `b` ([r][k]) of one case.
 fn gradient_harmonic(b: &[Vec<Complex64>], axis: FrameAxis, k: usize) -> [Complex64; 6] {
@@ -531,10 +542,32 @@ impl HarmonicProblem<'_> {
         }
     }
     /// `t` with the chain factors of the current modes: valid for a candidate that changed the
-    /// modes only (not the runout, the angles, the chain's other parts or the rows).
-    fn with_modes(&self, t: &Tables) -> Tables {
+    /// modes `ms` only (not the runout, the angles, the chain's other parts or the rows). Only
+    /// the components on the axes of `ms` are computed again (a per-axis scan changes one axis
+    /// of three); the others keep `t`'s factors, which are what [`HarmonicProblem::factor_with`]
+    /// gives for them, as no mode of their axis changed (the same values, bit for bit).
+    fn with_modes(&self, t: &Tables, ms: &[usize]) -> Tables {
+        let modes: Vec<SensorMode> = (0..self.mode_axes.len()).map(|m| self.mode(m)).collect();
+        let changed: Vec<FrameAxis> = ms.iter().map(|&m| self.mode_axes[m]).collect();
+        let h = (0..self.data.len())
+            .map(|c| {
+                let comps = &self.cases[c].waveform.components;
+                comps
+                    .iter()
+                    .zip(&t.h[c])
+                    .map(|(comp, old)| {
+                        if !changed.contains(&comp.axis) {
+                            return old.clone();
+                        }
+                        at_used(&t.used[c], Complex64::new(0.0, 0.0), |m| {
+                            self.factor_with(c, comp.axis, m, t.polar[c].as_deref(), &modes)
+                        })
+                    })
+                    .collect()
+            })
+            .collect();
         Tables {
-            h: self.chain_factors(&t.used, &t.polar),
+            h,
             used: Arc::clone(&t.used),
             polar: Arc::clone(&t.polar),
             g: Arc::clone(&t.g),
@@ -568,15 +601,7 @@ impl HarmonicProblem<'_> {
                     .waveform
                     .components
                     .iter()
-                    .map(|comp| {
-                        let mut t = vec![zero.clone(); used[c].len()];
-                        for (m, &u) in used[c].iter().enumerate() {
-                            if u {
-                                t[m] = f(c, comp.axis, m);
-                            }
-                        }
-                        t
-                    })
+                    .map(|comp| at_used(&used[c], zero.clone(), |m| f(c, comp.axis, m)))
                     .collect()
             })
             .collect()
@@ -722,33 +747,49 @@ impl HarmonicProblem<'_> {
         }
         Ok(())
     }
-    /// The coefficients of a mode-scan candidate: [`HarmonicProblem::linear_coefficients_with`]
-    /// by the normal equations (XᵀX)β = Xᵀy (Cholesky) instead of the SVD, when
-    /// κ(XᵀX) ≤ ‖XᵀX‖_F‖(XᵀX)⁻¹‖_F < 1e20 proves κ(X) < 1e10, far inside the SVD's rank test
-    /// (1e-12); otherwise by the SVD, with its errors. The scan only compares costs: at a
-    /// least-squares optimum the cost is stationary in β, so the β error of the normal equations
-    /// (relative κ(X)²·ε ≈ 1e-10 at κ(X) ~ 1e3) moves the cost by its square — far below the
-    /// differences between grid points — and every fit that reports coefficients solves them
-    /// again by the SVD afterwards.
-    fn scan_coefficients(&mut self, tables: &Tables) -> Result<(), IdentifyError> {
-        if self.coef_idx.is_empty() {
-            return Ok(());
+    /// The profile cost of a mode-scan candidate (its coefficients solved and set, as
+    /// [`HarmonicProblem::profile_cost_with`] does), cheaper:
+    ///
+    /// * the coefficients by the normal equations (XᵀX)β = Xᵀy (Cholesky) instead of the SVD,
+    ///   when κ(XᵀX) ≤ ‖XᵀX‖_F‖(XᵀX)⁻¹‖_F < 1e20 proves κ(X) < 1e10, far inside the SVD's rank
+    ///   test (1e-12); otherwise by the SVD, with its errors. The scan only compares costs: at a
+    ///   least-squares optimum the cost is stationary in β, so the β error of the normal
+    ///   equations (relative κ(X)²·ε ≈ 1e-10 at κ(X) ~ 1e3) moves the cost by its square — far
+    ///   below the differences between grid points — and every fit that reports coefficients
+    ///   solves them again by the SVD afterwards;
+    /// * the cost as ‖y − Xβ‖² through the design X already built (one product of an n × p
+    ///   matrix), where [`HarmonicProblem::residual_vec_with`] evaluates and folds the chained
+    ///   model again (a tenth of a mode scan's time). The two are the same residuals summed in
+    ///   another order when the coefficients held out of X are zero, as they are whenever
+    ///   coefficients are fitted (`base_kc` is zero outside `coef_idx`); otherwise the model's
+    ///   own residuals are used.
+    ///
+    /// An error (nothing set) when the linear solve fails.
+    fn scan_cost(&mut self, tables: &Tables) -> Result<f64, IdentifyError> {
+        let model_cost = |p: &mut Self| {
+            p.linear_coefficients_with(tables)?;
+            Ok(p.residual_vec_with(tables).iter().map(|r| r * r).sum())
+        };
+        let held_out_zero = (0..6)
+            .filter(|i| !self.coef_idx.contains(i))
+            .all(|i| self.base_kc[i] == 0.0);
+        if self.coef_idx.is_empty() || !held_out_zero {
+            return model_cost(self);
         }
         let x = self.coefficient_design(tables);
         let a = x.tr_mul(&x);
-        let Some(chol) = a.clone().cholesky() else {
-            return self.linear_coefficients_with(tables);
+        let beta = a.clone().cholesky().and_then(|chol| {
+            let bound = a.norm() * chol.inverse().norm();
+            (bound < 1e20).then(|| chol.solve(&x.tr_mul(&tables.y)))
+        });
+        let Some(beta) = beta else {
+            return model_cost(self);
         };
-        let bound = a.norm() * chol.inverse().norm();
-        if bound.is_nan() || bound >= 1e20 {
-            return self.linear_coefficients_with(tables);
-        }
-        let beta = chol.solve(&x.tr_mul(&tables.y));
         let c0 = self.coef_start();
         for c in 0..self.coef_idx.len() {
             self.x[c0 + c] = beta[c];
         }
-        Ok(())
+        Ok((&*tables.y - x * beta).norm_squared())
     }
     fn profile_cost(&mut self) -> f64 {
         let tables = self.tables();
@@ -1065,11 +1106,8 @@ fn grid_costs(
             .iter()
             .map(|&(f, z)| {
                 set(p, ms, f, z);
-                let t = p.with_modes(&base);
-                match p.scan_coefficients(&t) {
-                    Ok(()) => p.residual_vec_with(&t).iter().map(|r| r * r).sum(),
-                    Err(_) => f64::INFINITY,
-                }
+                let t = p.with_modes(&base, ms);
+                p.scan_cost(&t).unwrap_or(f64::INFINITY)
             })
             .collect();
     }
@@ -1082,12 +1120,9 @@ fn grid_costs(
             || shared.clone(),
             |q, &(f, z)| {
                 set(q, ms, f, z);
-                let tables = q.with_modes(base);
-                match q.scan_coefficients(&tables) {
-                    Ok(()) => {
-                        let c = q.residual_vec_with(&tables).iter().map(|r| r * r).sum();
-                        (c, Some((0..nk).map(|i| q.x[c0 + i]).collect()))
-                    }
+                let tables = q.with_modes(base, ms);
+                match q.scan_cost(&tables) {
+                    Ok(c) => (c, Some((0..nk).map(|i| q.x[c0 + i]).collect())),
                     Err(_) => (f64::INFINITY, None),
                 }
             },
@@ -1578,4 +1613,134 @@ pub(crate) fn harmonic_fit(
     });
     fit.chain = Some(report_chain);
     Ok(fit)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identify::AveragedWaveform;
+    use crate::{ArcChip, Cut, Cutter, ForceModel, MillingMode, Runout, Sampling};
+
+    /// One revolution of the K = 4 down-milling cut (ρ 8 µm) in x, y, z, 180 bins.
+    fn case() -> WaveformCase {
+        let cutter = Cutter::flat(10.0, 4, 30f64.to_radians()).unwrap();
+        let cut = Cut::new(3240.0, 0.05, 2.0)
+            .unwrap()
+            .radial(2.0, MillingMode::Down, &cutter)
+            .unwrap();
+        let kc = CuttingCoefficients::new([1889.2, 806.1, 291.0], [63.12, 113.7, 3.1]).unwrap();
+        let runout = Runout::new(0.008, -50f64.to_radians()).unwrap();
+        let m = ForceModel {
+            cutter: cutter.clone(),
+            runout,
+            cut,
+            coefficients: kc,
+        };
+        let chip = ArcChip::new(&cutter, &runout, 0.05).unwrap();
+        let s = m.simulate(&chip, &Sampling::new(1.0, 2.0, 50).unwrap());
+        let waveform = AveragedWaveform::average(
+            0.0,
+            180,
+            &[
+                (FrameAxis::X, &s.fx[..180]),
+                (FrameAxis::Y, &s.fy[..180]),
+                (FrameAxis::Z, &s.fz[..180]),
+            ],
+        )
+        .unwrap();
+        WaveformCase {
+            cutter,
+            cut,
+            waveform,
+        }
+    }
+
+    /// A stage-1 problem on `cases` with one fitted mode per axis (x, y, z), at ρ 8 µm.
+    fn problem(cases: &[WaveformCase]) -> HarmonicProblem<'_> {
+        let axes = [FrameAxis::X, FrameAxis::Y, FrameAxis::Z];
+        let chain = ChainOptions {
+            model: ChainModel::FitModes {
+                axes: axes.iter().map(|&a| (a, None)).collect(),
+                fit_gain: false,
+            },
+            spindle_hz: vec![54.0],
+            samples_per_rev: vec![Some(185.2)],
+            free_start_angle: vec![false],
+        };
+        let mut planner = RealFftPlanner::<f64>::new();
+        let data = vec![case_data(&cases[0], &chain, 0, None, &mut planner).unwrap()];
+        let c = &cases[0];
+        let models = vec![RevolutionModel::new(
+            &c.cutter,
+            &c.cut,
+            c.waveform.start_angle,
+            COARSE_OVERSAMPLE * c.waveform.samples(),
+            10,
+        )];
+        let np = 2 + 6 + 2 * axes.len();
+        let mut p = HarmonicProblem {
+            cases,
+            data,
+            models,
+            coef_idx: vec![0, 1, 2, 3, 4, 5],
+            base_kc: [0.0; 6],
+            fit_tilt: false,
+            known: None,
+            mode_axes: axes.to_vec(),
+            fit_gain: false,
+            fixed_gain: vec![1.0; axes.len()],
+            max_mode_ln_hz: 16.1,
+            x: DVector::zeros(np),
+            basis: Vec::new(),
+            planner_cache: vec![planner.plan_fft_forward(COARSE_OVERSAMPLE * 180)],
+            oversample: COARSE_OVERSAMPLE,
+            rigid: false,
+            freeze_runout: false,
+            tooth_harmonics_only: None,
+        };
+        for (m, f) in [900.0f64, 1300.0, 2500.0].iter().enumerate() {
+            let o = p.mode_offset(m);
+            p.x[o] = f.ln();
+            p.x[o + 1] = 0.03f64.ln();
+        }
+        let lambda = (-50f64).to_radians();
+        p.set_runout([0.008 * lambda.cos(), 0.008 * lambda.sin()]);
+        p.set_smooth(true);
+        p
+    }
+
+    /// The mode scans' shortcuts against the full computations, with each axis's mode moved in
+    /// turn and all three at once: the chain factors of [`HarmonicProblem::with_modes`] equal
+    /// the tables computed afresh bit for bit, and [`HarmonicProblem::scan_cost`] gives the
+    /// profile cost (SVD solve, model residuals) to 1e-9 relative and its coefficients to 1e-7
+    /// (the normal equations' κ²ε at κ ~ 1e3, with margin).
+    #[test]
+    fn mode_scan_shortcuts_equal_the_full_computations() {
+        let cases = [case()];
+        let p = problem(&cases);
+        let base = p.tables();
+        let moves: [&[usize]; 4] = [&[0], &[1], &[2], &[0, 1, 2]];
+        for (i, ms) in moves.iter().enumerate() {
+            let mut q = p.clone();
+            for &m in *ms {
+                let o = q.mode_offset(m);
+                q.x[o] = (700.0 + 450.0 * (i + m) as f64).ln();
+                q.x[o + 1] = 0.05f64.ln();
+            }
+            let quick = q.with_modes(&base, ms);
+            let full = q.tables();
+            assert_eq!(quick.h, full.h, "modes {ms:?}");
+            // a stale axis would be caught: the unchanged axes really differ between modes
+            assert_ne!(base.h, full.h);
+            let mut a = q.clone();
+            let cost = a.scan_cost(&full).unwrap();
+            let mut b = q.clone();
+            let want = b.profile_cost_with(&full);
+            assert!((cost - want).abs() <= 1e-9 * want, "{cost} vs {want}");
+            for c in 0..6 {
+                let (x, y) = (a.x[2 + c], b.x[2 + c]);
+                assert!((x - y).abs() <= 1e-7 * y.abs().max(1.0), "K{c}: {x} vs {y}");
+            }
+        }
+    }
 }
