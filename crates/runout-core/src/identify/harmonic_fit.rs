@@ -710,21 +710,33 @@ impl HarmonicProblem<'_> {
     /// Design matrix of the coefficients (chain included), from the tables of the current
     /// parameters.
     fn coefficient_design(&self, tables: &Tables) -> DMatrix<f64> {
-        let n = self.n_residuals();
-        let mut x = DMatrix::zeros(n, self.coef_idx.len());
+        let mut x = DMatrix::zeros(self.n_residuals(), self.coef_idx.len());
+        self.coefficient_design_rows(tables, &mut x, None);
+        x
+    }
+    /// The rows of [`HarmonicProblem::coefficient_design`] written into `x`: those of the
+    /// components on `axes` only, or all of them (`None`); the other rows are left as they are.
+    fn coefficient_design_rows(
+        &self,
+        tables: &Tables,
+        x: &mut DMatrix<f64>,
+        axes: Option<&[FrameAxis]>,
+    ) {
         let mut row = 0;
         self.rows(|c, comp, k, s| {
-            let folded = self.fold_gradient(c, k, &tables.h[c][comp], &tables.g[c][comp]);
-            for (j, &i) in self.coef_idx.iter().enumerate() {
-                let v = folded[i];
-                x[(row, j)] = v.re * s;
-                if k > 0 {
-                    x[(row + 1, j)] = v.im * s;
+            let axis = self.cases[c].waveform.components[comp].axis;
+            if axes.is_none_or(|a| a.contains(&axis)) {
+                let folded = self.fold_gradient(c, k, &tables.h[c][comp], &tables.g[c][comp]);
+                for (j, &i) in self.coef_idx.iter().enumerate() {
+                    let v = folded[i];
+                    x[(row, j)] = v.re * s;
+                    if k > 0 {
+                        x[(row + 1, j)] = v.im * s;
+                    }
                 }
             }
             row += if k > 0 { 2 } else { 1 };
         });
-        x
     }
     fn linear_coefficients(&mut self) -> Result<(), IdentifyError> {
         if self.coef_idx.is_empty() {
@@ -763,9 +775,16 @@ impl HarmonicProblem<'_> {
     ///   another order when the coefficients held out of X are zero, as they are whenever
     ///   coefficients are fitted (`base_kc` is zero outside `coef_idx`); otherwise the model's
     ///   own residuals are used.
+    /// * with `base`, the design of the scan's base tables and the axes whose modes the
+    ///   candidate moved: only those axes' rows are built again, the others copied (the same
+    ///   values, as their chain factors are the base's: [`HarmonicProblem::with_modes`]).
     ///
     /// An error (nothing set) when the linear solve fails.
-    fn scan_cost(&mut self, tables: &Tables) -> Result<f64, IdentifyError> {
+    fn scan_cost(
+        &mut self,
+        tables: &Tables,
+        base: Option<(&DMatrix<f64>, &[FrameAxis])>,
+    ) -> Result<f64, IdentifyError> {
         let model_cost = |p: &mut Self| {
             p.linear_coefficients_with(tables)?;
             Ok(p.residual_vec_with(tables).iter().map(|r| r * r).sum())
@@ -776,7 +795,14 @@ impl HarmonicProblem<'_> {
         if self.coef_idx.is_empty() || !held_out_zero {
             return model_cost(self);
         }
-        let x = self.coefficient_design(tables);
+        let x = match base {
+            Some((design, axes)) => {
+                let mut x = design.clone();
+                self.coefficient_design_rows(tables, &mut x, Some(axes));
+                x
+            }
+            None => self.coefficient_design(tables),
+        };
         let a = x.tr_mul(&x);
         let beta = a.clone().cholesky().and_then(|chol| {
             let bound = a.norm() * chol.inverse().norm();
@@ -1099,15 +1125,19 @@ fn grid_costs(
     grid: &[(f64, f64)],
     set: &(impl Fn(&mut HarmonicProblem<'_>, &[usize], f64, f64) + Sync),
 ) -> Vec<f64> {
-    // the candidates change the modes only: the rest of the tables is computed once
+    // the candidates change the modes only: the rest of the tables is computed once, and the
+    // design's rows of the axes without a moved mode
     let base = p.tables();
+    let axes: Vec<FrameAxis> = ms.iter().map(|&m| p.mode_axes[m]).collect();
+    let design = (!p.coef_idx.is_empty()).then(|| p.coefficient_design(&base));
+    let reuse = design.as_ref().map(|d| (d, &axes[..]));
     if rayon::current_num_threads() <= 1 || grid.len() < 2 {
         return grid
             .iter()
             .map(|&(f, z)| {
                 set(p, ms, f, z);
                 let t = p.with_modes(&base, ms);
-                p.scan_cost(&t).unwrap_or(f64::INFINITY)
+                p.scan_cost(&t, reuse).unwrap_or(f64::INFINITY)
             })
             .collect();
     }
@@ -1121,7 +1151,7 @@ fn grid_costs(
             |q, &(f, z)| {
                 set(q, ms, f, z);
                 let tables = q.with_modes(base, ms);
-                match q.scan_cost(&tables) {
+                match q.scan_cost(&tables, reuse) {
                     Ok(c) => (c, Some((0..nk).map(|i| q.x[c0 + i]).collect())),
                     Err(_) => (f64::INFINITY, None),
                 }
@@ -1711,7 +1741,8 @@ mod tests {
 
     /// The mode scans' shortcuts against the full computations, with each axis's mode moved in
     /// turn and all three at once: the chain factors of [`HarmonicProblem::with_modes`] equal
-    /// the tables computed afresh bit for bit, and [`HarmonicProblem::scan_cost`] gives the
+    /// the tables computed afresh bit for bit, the design with the unmoved axes' rows copied
+    /// gives the same cost and coefficients bit for bit, and [`HarmonicProblem::scan_cost`] gives the
     /// profile cost (SVD solve, model residuals) to 1e-9 relative and its coefficients to 1e-7
     /// (the normal equations' κ²ε at κ ~ 1e3, with margin).
     #[test]
@@ -1732,8 +1763,15 @@ mod tests {
             assert_eq!(quick.h, full.h, "modes {ms:?}");
             // a stale axis would be caught: the unchanged axes really differ between modes
             assert_ne!(base.h, full.h);
+            // the design's rows of the unmoved axes copied from the base design: the same bits
+            let axes: Vec<FrameAxis> = ms.iter().map(|&m| q.mode_axes[m]).collect();
+            let design = q.coefficient_design(&base);
+            let mut r = q.clone();
+            let reused = r.scan_cost(&quick, Some((&design, &axes))).unwrap();
             let mut a = q.clone();
-            let cost = a.scan_cost(&full).unwrap();
+            let cost = a.scan_cost(&full, None).unwrap();
+            assert_eq!(reused.to_bits(), cost.to_bits(), "modes {ms:?}");
+            assert_eq!(r.x, a.x);
             let mut b = q.clone();
             let want = b.profile_cost_with(&full);
             assert!((cost - want).abs() <= 1e-9 * want, "{cost} vs {want}");
