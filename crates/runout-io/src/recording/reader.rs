@@ -4,6 +4,8 @@ use super::error::RecordingError;
 use super::header::{
     detect_decimal_comma, detect_delimiter, is_unit_row, key_line, meta_number, split_unit,
 };
+#[cfg(target_arch = "x86_64")]
+use super::text::WideCells;
 use super::text::{
     binary_issue, decode, delimiter_ends_numbers, fields, parse_common_cell, parse_leading_number,
     parse_number, trim_field,
@@ -1016,6 +1018,54 @@ impl RowParser<'_> {
             }
         }
         None
+    }
+
+    /// The common row `bytes[pos..]` whose cells end at the indexed positions `from + ends[j]`
+    /// (a structural index: the delimiters and the line feed of the row, in order): its channel
+    /// values pushed to `values` and its time cell's value returned (scaled; NaN without a
+    /// time column). `None` when a cell ends at another byte or is not a plain number cell
+    /// ([`WideCells::number_cell`]), with values possibly pushed (the caller truncates). For a
+    /// row it takes, values and time are [`RowParser::parse_common_line`]'s (the same cells
+    /// parsed to the same bits), the line's length aside (the caller checks it).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "ssse3,sse4.1")]
+    #[inline]
+    pub(super) fn indexed_row(
+        &self,
+        wide: WideCells,
+        bytes: &[u8],
+        pos: usize,
+        from: usize,
+        ends: &[u32],
+        values: &mut [Vec<f64>],
+    ) -> Option<f64> {
+        let last = ends.len().checked_sub(1)?;
+        let mut start = pos;
+        let mut time = f64::NAN;
+        for (j, (&e, slot)) in ends.iter().zip(self.slots).enumerate() {
+            let e = from + e as usize;
+            let mut end = e;
+            if j < last {
+                if bytes[e] != self.delim {
+                    return None;
+                }
+            } else {
+                if bytes[e] != b'\n' {
+                    return None;
+                }
+                if end > start && bytes[end - 1] == b'\r' {
+                    end -= 1;
+                }
+            }
+            let v = wide.number_cell(bytes, start, end.checked_sub(start)?, self.dc)?;
+            match *slot {
+                Slot::Channel(k) => values[k].push(v),
+                Slot::Time => time = v * self.time_scale,
+                Slot::Skip => return None,
+            }
+            start = e + 1;
+        }
+        Some(time)
     }
 
     fn cell_error(&self, line: u64, row: &[u8], j: usize, cell: &[u8]) -> RecordingError {

@@ -104,6 +104,190 @@ pub(crate) fn parse_common_cell(
     None
 }
 
+/// Recording rows parsed sixteen and sixty-four bytes at a time (issue 18), on x86-64 with
+/// SSSE3 and SSE4.1 ([`WideCells::detect`]): the positions of a stretch's delimiters and line
+/// feeds ([`WideCells::structurals`]), then each number cell from its known bounds
+/// ([`WideCells::number_cell`]), without a branch per digit and without one cell's parse
+/// waiting for the previous cell's end.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WideCells {
+    /// Private: made only by [`WideCells::detect`], so holding one proves the CPU features.
+    _proof: (),
+}
+
+#[cfg(target_arch = "x86_64")]
+impl WideCells {
+    /// The wide parser when this CPU can run it.
+    pub(crate) fn detect() -> Option<Self> {
+        (is_x86_feature_detected!("ssse3") && is_x86_feature_detected!("sse4.1"))
+            .then_some(Self { _proof: () })
+    }
+
+    /// The positions of the bytes `delim` and `\n` in `bytes[from..to]`, counted from `from`,
+    /// written to the start of `at` (which must hold `to − from + 64` positions: the spare room
+    /// takes unconditional writes); returns how many. Sixty-four bytes per step: four compares
+    /// give the step's bit mask, whose set bits are written eight at a time (a branch per
+    /// eight positions, not per position, as in simdjson's structural index).
+    #[target_feature(enable = "ssse3,sse4.1")]
+    #[inline]
+    pub(crate) fn structurals(
+        self,
+        bytes: &[u8],
+        from: usize,
+        to: usize,
+        delim: u8,
+        at: &mut [u32],
+    ) -> usize {
+        wide::structurals(&bytes[from..to], delim, at)
+    }
+
+    /// The number cell `bytes[a..a + len]` (a sign, digits, at most one decimal point — `.`, or
+    /// `,` too with decimal commas — and at least one digit, at most 15 bytes), when 16 bytes
+    /// from `a` are readable: `±mant / 10^frac_digits`, the same expression on the same
+    /// integers as [`parse_common_cell`]'s fast path, so the same bits as [`parse_number`] of
+    /// the cell. `None` for any other cell (the caller parses the row the scalar way).
+    ///
+    /// The cell's digit and point positions come from vector compares (bit masks), the digits
+    /// are gathered right-aligned into one register (`pshufb`, with a mask looked up by the
+    /// lengths of the integer and fraction runs) and combined by the multiply-add ladder of SIMD
+    /// number parsing (10·a + b, 100·a + b, 10⁴·a + b, then 10⁸·a + b).
+    #[target_feature(enable = "ssse3,sse4.1")]
+    #[inline]
+    pub(crate) fn number_cell(
+        self,
+        bytes: &[u8],
+        a: usize,
+        len: usize,
+        decimal_comma: bool,
+    ) -> Option<f64> {
+        let window: &[u8; 16] = bytes.get(a..a.checked_add(16)?)?.try_into().ok()?;
+        wide::number_cell(window, len, decimal_comma)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod wide {
+    use super::{with_sign, POW10};
+    use std::arch::x86_64::*;
+
+    /// Shuffle masks by the lengths of the integer run `a` and the fraction run `b` (`a + b ≤
+    /// 15`): output byte `i` of 16 takes digit `k = i − (16 − a − b)` of the cell (counted from
+    /// the first digit, skipping the decimal point after `a` digits), or zero (`0x80`) for
+    /// `k < 0`. The sign's offset (0 or 1) is added at run time; `0x80 + 1` still selects zero.
+    static GATHER: [[[u8; 16]; 16]; 16] = gather_masks();
+
+    const fn gather_masks() -> [[[u8; 16]; 16]; 16] {
+        let mut t = [[[0x80u8; 16]; 16]; 16];
+        let mut a = 0;
+        while a < 16 {
+            let mut b = 0;
+            while a + b < 16 {
+                let n = a + b;
+                let mut i = 16 - n;
+                while i < 16 {
+                    let k = i - (16 - n);
+                    t[a][b][i] = if k < a { k as u8 } else { (k + 1) as u8 };
+                    i += 1;
+                }
+                b += 1;
+            }
+            a += 1;
+        }
+        t
+    }
+
+    /// See [`super::WideCells::structurals`].
+    #[target_feature(enable = "ssse3,sse4.1")]
+    #[inline]
+    pub(super) fn structurals(text: &[u8], delim: u8, at: &mut [u32]) -> usize {
+        assert!(at.len() >= text.len() + 64, "room for the positions");
+        let (d, nl) = (_mm_set1_epi8(delim as i8), _mm_set1_epi8(b'\n' as i8));
+        let mut n = 0;
+        let mut base = 0u32;
+        let mut blocks = text.chunks_exact(64);
+        for block in &mut blocks {
+            let mut m = 0u64;
+            for (q, part) in block.chunks_exact(16).enumerate() {
+                // SAFETY: `part` has 16 bytes; unaligned load.
+                let v = unsafe { _mm_loadu_si128(part.as_ptr().cast()) };
+                let hit = _mm_or_si128(_mm_cmpeq_epi8(v, d), _mm_cmpeq_epi8(v, nl));
+                m |= u64::from(_mm_movemask_epi8(hit) as u32) << (16 * q);
+            }
+            // at most `base` positions so far, so `n + 64 ≤ text.len() + 64`
+            let out = &mut at[n..n + 64];
+            let count = m.count_ones() as usize;
+            let mut k = 0;
+            while k < count {
+                for slot in &mut out[k..k + 8] {
+                    *slot = base + m.trailing_zeros();
+                    m &= m.wrapping_sub(1);
+                }
+                k += 8;
+            }
+            n += count;
+            base += 64;
+        }
+        for (k, &c) in blocks.remainder().iter().enumerate() {
+            if c == delim || c == b'\n' {
+                at[n] = base + k as u32;
+                n += 1;
+            }
+        }
+        n
+    }
+
+    /// See [`super::WideCells::number_cell`]; the cell is the first `len` bytes of `window`.
+    #[target_feature(enable = "ssse3,sse4.1")]
+    #[inline]
+    pub(super) fn number_cell(window: &[u8; 16], len: usize, decimal_comma: bool) -> Option<f64> {
+        if len == 0 || len > 15 {
+            return None;
+        }
+        // SAFETY: 16 bytes; unaligned load.
+        let v = unsafe { _mm_loadu_si128(window.as_ptr().cast()) };
+        let d = _mm_sub_epi8(v, _mm_set1_epi8(b'0' as i8));
+        // unsigned d ≤ 9 ⇔ min(d, 9) == d
+        let digit = _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_min_epu8(d, _mm_set1_epi8(9)), d)) as u32;
+        let mut point = _mm_cmpeq_epi8(v, _mm_set1_epi8(b'.' as i8));
+        if decimal_comma {
+            point = _mm_or_si128(point, _mm_cmpeq_epi8(v, _mm_set1_epi8(b',' as i8)));
+        }
+        let point = _mm_movemask_epi8(point) as u32;
+        let first = window[0];
+        let neg = first == b'-';
+        let s = u32::from(neg || first == b'+');
+        let len = len as u32;
+        // the cell's bytes after the sign that are not digits: none, or one decimal point
+        let other = ((1u32 << len) - 1) & !((1u32 << s) - 1) & !digit;
+        if other & other.wrapping_sub(1) != 0 || other & !point != 0 {
+            return None;
+        }
+        let has_point = other != 0;
+        let p = if has_point {
+            other.trailing_zeros()
+        } else {
+            len
+        };
+        let (a, b) = ((p - s) as usize, (len - p - u32::from(has_point)) as usize);
+        if a + b == 0 {
+            return None;
+        }
+        // SAFETY: a + b ≤ 15 (len ≤ 15), inside the table; 16-byte unaligned load of it.
+        let mask = unsafe { _mm_loadu_si128(GATHER[a][b].as_ptr().cast()) };
+        let digits = _mm_shuffle_epi8(d, _mm_add_epi8(mask, _mm_set1_epi8(s as i8)));
+        let pairs = _mm_maddubs_epi16(digits, _mm_set1_epi16(0x010a)); // 10·d₀ + d₁
+        let quads = _mm_madd_epi16(pairs, _mm_set1_epi32(0x0001_0064)); // 100·p₀ + p₁
+        let quads16 = _mm_packus_epi32(quads, quads);
+        let octs = _mm_madd_epi16(quads16, _mm_set1_epi32(0x0001_2710)); // 10⁴·q₀ + q₁
+        let hi = _mm_cvtsi128_si32(octs) as u32;
+        let lo = _mm_extract_epi32(octs, 1) as u32;
+        // below 10¹⁵ < 2⁵³: exact as i64 and as f64
+        let mant = u64::from(hi) * 100_000_000 + u64::from(lo);
+        Some(with_sign(mant as i64 as f64 / POW10[b], neg))
+    }
+}
+
 /// [`parse_leading_number`] for a cell whose digits did not reach the delimiter (an exponent):
 /// its end is searched from where the scan stopped, and the cell parsed on from there when it
 /// is already trimmed (it starts with a digit, a sign or a point, so only its end can hold
@@ -163,8 +347,15 @@ impl Mantissa {
             return None;
         }
         let v = self.mant as f64 / POW10[self.frac_digits];
-        Some(if self.neg { -v } else { v })
+        Some(with_sign(v, self.neg))
     }
+}
+
+/// `-v` when `neg`, else `v`, for `v ≥ +0`: the sign bit set without a branch (a recording's
+/// signs are as random as its noise, so a branch on them is mispredicted every other cell).
+#[inline(always)]
+fn with_sign(v: f64, neg: bool) -> f64 {
+    f64::from_bits(v.to_bits() | (u64::from(neg) << 63))
 }
 
 /// Scan a trimmed cell's sign, integer and fraction digits (two tight digit loops, shared by
@@ -172,11 +363,10 @@ impl Mantissa {
 #[inline(always)]
 fn scan_mantissa(b: &[u8], decimal_comma: bool) -> Mantissa {
     let n = b.len();
-    let (neg, mut i) = match b.first() {
-        Some(b'-') => (true, 1),
-        Some(b'+') => (false, 1),
-        _ => (false, 0),
-    };
+    // the sign without a branch (random in recordings, see `with_sign`)
+    let first = b.first().copied().unwrap_or(0);
+    let neg = first == b'-';
+    let mut i = usize::from(neg || first == b'+');
     let digits = |mut i: usize, mant: &mut u64| {
         while i < n {
             let d = b[i].wrapping_sub(b'0');

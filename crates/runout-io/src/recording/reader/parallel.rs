@@ -15,6 +15,8 @@ use super::{
     RowParser, Slot, MAX_LINE_BYTES,
 };
 use crate::mapped::MappedFile;
+#[cfg(target_arch = "x86_64")]
+use crate::recording::text::WideCells;
 use std::io::{BufRead, Read};
 use std::sync::mpsc;
 
@@ -62,6 +64,9 @@ struct Parsed {
     text: Vec<u8>,
     /// A mapped job's bytes in the map (its `text` is then empty).
     span: Option<(usize, usize)>,
+    /// Rows taken from the structural index (tests check the wide path is taken).
+    #[cfg(test)]
+    indexed: usize,
 }
 
 impl Parsed {
@@ -110,68 +115,258 @@ impl Parsed {
 /// length limit, `\r\n` endings, blank lines skipped), the time cells unchecked. A common row
 /// (plain numbers, nothing else) is parsed as it is scanned, without a search for its end first
 /// (`RowParser::parse_common_line`); any other line, or a common row's line when such rows are
-/// rare in the job, takes the full path.
+/// rare in the job, takes the full path. On x86-64 with SSSE3 and SSE4.1 common rows are first
+/// taken from a structural index ([`parse_job_wide`]), with the same results.
 fn parse_job(p: &RowParser<'_>, has_time: bool, bytes: &[u8], out: &mut Parsed) {
-    out.bytes = bytes.len() as u64;
-    let mut pos = 0;
-    let mut line = 0u64;
-    let mut common = p.common_lines();
-    let mut misses = 0u64;
-    while pos < bytes.len() {
-        let rest = &bytes[pos..];
-        if common {
-            let mut time = None;
-            if let Some(consumed) = p.parse_common_line(rest, &mut out.values, &mut time) {
-                if has_time {
-                    out.times.push(time.unwrap_or(f64::NAN));
-                }
-                out.rows += 1;
-                line += 1;
-                pos += consumed;
-                continue;
-            }
-            for v in &mut out.values {
-                v.truncate(out.rows);
-            }
-            // lines of another form (exponents, blanks, quotes) go the full way; when they are
-            // more than one in eight, the job stops trying the common path first
-            misses += 1;
-            common = misses < COMMON_MISSES || misses * 8 < line;
-        }
-        let (mut len, consumed) = match memchr::memchr(b'\n', rest) {
-            Some(k) => (k, k + 1),
-            None => (rest.len(), rest.len()),
-        };
-        line += 1;
-        if len as u64 >= MAX_LINE_BYTES {
-            out.error = Some(long_line(&p.info.file, line));
-            out.error_bytes = pos as u64;
-            break;
-        }
-        pos += consumed;
-        if len > 0 && rest[len - 1] == b'\r' {
-            len -= 1;
-        }
-        let row = &rest[..len];
-        if trim_field(row).is_empty() {
-            out.blank.push(line - 1);
-            continue;
-        }
-        let mut time = None;
-        if let Err(e) = p.parse(line, row, &mut out.values, &mut time) {
-            for v in &mut out.values {
-                v.truncate(out.rows);
-            }
-            out.error = Some(e);
-            out.error_bytes = pos as u64;
-            break;
-        }
-        if has_time {
-            out.times.push(time.unwrap_or(f64::NAN));
-        }
-        out.rows += 1;
+    #[cfg(target_arch = "x86_64")]
+    if let Some(wide) = WideCells::detect() {
+        // SAFETY: `detect` found the features `parse_job_wide` is compiled for.
+        unsafe { parse_job_wide(wide, p, has_time, bytes, out) };
+        return;
     }
-    out.lines = line;
+    parse_job_scalar(p, has_time, bytes, out);
+}
+
+/// [`parse_job`] line by line, without the wide parser.
+fn parse_job_scalar(p: &RowParser<'_>, has_time: bool, bytes: &[u8], out: &mut Parsed) {
+    out.bytes = bytes.len() as u64;
+    let mut st = JobState::new(p);
+    while st.pos < bytes.len() {
+        if !parse_job_line(p, has_time, bytes, &mut st, out) {
+            break;
+        }
+    }
+    out.lines = st.line;
+}
+
+/// [`parse_job`] on x86-64 with SSSE3 and SSE4.1: common rows are taken from a structural
+/// index of the text (issue 18). The positions of every delimiter and line feed of a block of
+/// the job are found first, 64 bytes per step (`wide::structurals`); a row then has the bounds
+/// of all its cells before any is parsed, so the cells are parsed independently of each other
+/// (`wide::number_cell`) instead of each cell's start waiting for the previous cell's digit scan
+/// to end (that chain of loads, compares and exits was the parse's time, whatever the scan's
+/// width). A row the index cannot take (another form, too close to the job's end) goes through
+/// [`parse_job_line`], and the index resumes after it.
+///
+/// # Safety
+/// The CPU must have SSSE3 and SSE4.1 (which holding a [`WideCells`] proves).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "ssse3,sse4.1")]
+unsafe fn parse_job_wide(
+    wide: WideCells,
+    p: &RowParser<'_>,
+    has_time: bool,
+    bytes: &[u8],
+    out: &mut Parsed,
+) {
+    out.bytes = bytes.len() as u64;
+    let mut st = JobState::new(p);
+    let mut index = StructuralIndex::new(p.slots.len());
+    let mut fast = st.common;
+    let mut fast_misses = 0u64;
+    while st.pos < bytes.len() {
+        if fast {
+            match index.row(wide, p, bytes, st.pos, &mut out.values) {
+                IndexedRow::Row(next, time) => {
+                    #[cfg(test)]
+                    {
+                        out.indexed += 1;
+                    }
+                    if has_time {
+                        out.times.push(time);
+                    }
+                    out.rows += 1;
+                    st.line += 1;
+                    st.pos = next;
+                    continue;
+                }
+                IndexedRow::Other => {
+                    for v in &mut out.values {
+                        v.truncate(out.rows);
+                    }
+                    // a job of other rows stops indexing as the common path stops (below)
+                    fast_misses += 1;
+                    fast = fast_misses < COMMON_MISSES || fast_misses * 8 < st.line;
+                }
+                IndexedRow::Unindexed => {}
+            }
+        }
+        if !parse_job_line(p, has_time, bytes, &mut st, out) {
+            break;
+        }
+    }
+    out.lines = st.line;
+}
+
+/// Where a job's parse stands: the next line's first byte, the lines done, and whether common
+/// rows are still tried first (and how often they failed).
+struct JobState {
+    pos: usize,
+    line: u64,
+    common: bool,
+    misses: u64,
+}
+
+impl JobState {
+    fn new(p: &RowParser<'_>) -> Self {
+        Self {
+            pos: 0,
+            line: 0,
+            common: p.common_lines(),
+            misses: 0,
+        }
+    }
+}
+
+/// The line of `bytes` at `st.pos` (which is before the end) parsed into `out` and `st` moved
+/// past it: a common row first when such rows are the job's rule, else the full path. False
+/// after an error (recorded in `out`): the job stops there.
+#[inline(always)]
+fn parse_job_line(
+    p: &RowParser<'_>,
+    has_time: bool,
+    bytes: &[u8],
+    st: &mut JobState,
+    out: &mut Parsed,
+) -> bool {
+    let rest = &bytes[st.pos..];
+    if st.common {
+        let mut time = None;
+        if let Some(consumed) = p.parse_common_line(rest, &mut out.values, &mut time) {
+            if has_time {
+                out.times.push(time.unwrap_or(f64::NAN));
+            }
+            out.rows += 1;
+            st.line += 1;
+            st.pos += consumed;
+            return true;
+        }
+        for v in &mut out.values {
+            v.truncate(out.rows);
+        }
+        // lines of another form (exponents, blanks, quotes) go the full way; when they are
+        // more than one in eight, the job stops trying the common path first
+        st.misses += 1;
+        st.common = st.misses < COMMON_MISSES || st.misses * 8 < st.line;
+    }
+    let (mut len, consumed) = match memchr::memchr(b'\n', rest) {
+        Some(k) => (k, k + 1),
+        None => (rest.len(), rest.len()),
+    };
+    st.line += 1;
+    if len as u64 >= MAX_LINE_BYTES {
+        out.error = Some(long_line(&p.info.file, st.line));
+        out.error_bytes = st.pos as u64;
+        return false;
+    }
+    st.pos += consumed;
+    if len > 0 && rest[len - 1] == b'\r' {
+        len -= 1;
+    }
+    let row = &rest[..len];
+    if trim_field(row).is_empty() {
+        out.blank.push(st.line - 1);
+        return true;
+    }
+    let mut time = None;
+    if let Err(e) = p.parse(st.line, row, &mut out.values, &mut time) {
+        for v in &mut out.values {
+            v.truncate(out.rows);
+        }
+        out.error = Some(e);
+        out.error_bytes = st.pos as u64;
+        return false;
+    }
+    if has_time {
+        out.times.push(time.unwrap_or(f64::NAN));
+    }
+    out.rows += 1;
+    true
+}
+
+/// Bytes of a job indexed at a time (the positions stay in the first-level cache).
+#[cfg(target_arch = "x86_64")]
+const INDEX_BYTES: usize = 16 << 10;
+
+/// The positions of the delimiters and line feeds of a stretch of a job, taken row by row.
+#[cfg(target_arch = "x86_64")]
+struct StructuralIndex {
+    /// Positions (from `from`) of the stretch's structural bytes; `len` of them are valid.
+    at: Vec<u32>,
+    len: usize,
+    /// The next position to take.
+    next: usize,
+    /// The stretch's first byte in the job (`usize::MAX` before the first stretch).
+    from: usize,
+    /// Cells per row.
+    slots: usize,
+}
+
+/// What the index made of the row at a position.
+#[cfg(target_arch = "x86_64")]
+enum IndexedRow {
+    /// A common row: where the next line starts, and the time cell's value (scaled; NaN
+    /// without a time column).
+    Row(usize, f64),
+    /// Not a common row (values of the row may have been pushed: the caller truncates).
+    Other,
+    /// The row's end is not indexed (a long line, or too close to the job's end for the
+    /// wide loads): the line goes the scalar way, which does not count as another form.
+    Unindexed,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl StructuralIndex {
+    fn new(slots: usize) -> Self {
+        Self {
+            at: vec![0; INDEX_BYTES + 64],
+            len: 0,
+            next: 0,
+            from: usize::MAX,
+            slots,
+        }
+    }
+
+    /// The row that starts at `pos`, parsed from its indexed cells.
+    #[target_feature(enable = "ssse3,sse4.1")]
+    #[inline]
+    fn row(
+        &mut self,
+        wide: WideCells,
+        p: &RowParser<'_>,
+        bytes: &[u8],
+        pos: usize,
+        values: &mut [Vec<f64>],
+    ) -> IndexedRow {
+        // positions before `pos` belong to lines taken the other way
+        while self.next < self.len && self.from + (self.at[self.next] as usize) < pos {
+            self.next += 1;
+        }
+        if self.next + self.slots > self.len {
+            if self.from == pos {
+                return IndexedRow::Unindexed;
+            }
+            let to = (pos + INDEX_BYTES).min(bytes.len());
+            self.len = wide.structurals(bytes, pos, to, p.delim, &mut self.at);
+            self.from = pos;
+            self.next = 0;
+            if self.slots > self.len {
+                return IndexedRow::Unindexed;
+            }
+        }
+        let ends = &self.at[self.next..self.next + self.slots];
+        let line_end = self.from + ends[self.slots - 1] as usize;
+        if line_end + 16 > bytes.len() {
+            return IndexedRow::Unindexed;
+        }
+        match p.indexed_row(wide, bytes, pos, self.from, ends, values) {
+            Some(time) if (line_end + 1 - pos) as u64 <= MAX_LINE_BYTES => {
+                self.next += self.slots;
+                IndexedRow::Row(line_end + 1, time)
+            }
+            _ => IndexedRow::Other,
+        }
+    }
 }
 
 /// Cut the input into jobs of whole lines, starting with `carry` (bytes read ahead, not
@@ -532,5 +727,220 @@ fn shift_line(e: &mut RecordingError, before: u64) {
         | RecordingError::TimeNotMonotonic { line, .. }
         | RecordingError::RateInconsistent { line, .. } => *line += before,
         _ => {}
+    }
+}
+
+/// The wide parse of a job equals the line-by-line one, field by field and bit for bit.
+#[cfg(all(test, target_arch = "x86_64"))]
+mod wide_tests {
+    use super::*;
+    use crate::recording::ReadOptions;
+
+    /// `(rows, times, values, blank, lines, bytes, error, error_bytes)` with floats as bits.
+    type Summary = (
+        usize,
+        Vec<u64>,
+        Vec<Vec<u64>>,
+        Vec<u64>,
+        u64,
+        u64,
+        Option<String>,
+        u64,
+    );
+
+    fn summary(out: &Parsed) -> Summary {
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        (
+            out.rows,
+            bits(&out.times),
+            out.values.iter().map(|v| bits(v)).collect(),
+            out.blank.clone(),
+            out.lines,
+            out.bytes,
+            out.error.as_ref().map(ToString::to_string),
+            out.error_bytes,
+        )
+    }
+
+    /// Both parses of `body` (the data rows after `header`), and whether the wide one ran.
+    fn both(header: &str, body: &str) -> (Summary, Summary) {
+        // the parser of a recording with this header (its own rows give the sample rate)
+        let (d, p) = if header.contains(';') {
+            (';', ',')
+        } else {
+            (',', '.')
+        };
+        let rows: String = (0..5)
+            .map(|k| format!("0{p}0{k}{d}1{p}5{d}2{p}5\n"))
+            .collect();
+        let text = format!("{header}{rows}");
+        let r = RecordingReader::from_bytes("w.csv", text.as_bytes(), &ReadOptions::new())
+            .expect("header");
+        let p = r.row_parser();
+        let has_time = p.slots.contains(&Slot::Time);
+        let channels = r.info().columns.len();
+        let run = |wide: bool| {
+            let mut out = Parsed::default();
+            out.reset(channels);
+            match WideCells::detect() {
+                // SAFETY: detected.
+                Some(w) if wide => unsafe {
+                    parse_job_wide(w, &p, has_time, body.as_bytes(), &mut out)
+                },
+                _ => parse_job_scalar(&p, has_time, body.as_bytes(), &mut out),
+            }
+            summary(&out)
+        };
+        (run(false), run(true))
+    }
+
+    /// A cell of the kinds recordings hold, and of the kinds the wide parser must refuse.
+    fn cell(kind: u8, v: f64, d: usize, comma: bool) -> String {
+        let plain = format!("{v:.d$}");
+        let plain = if comma {
+            plain.replace('.', ",")
+        } else {
+            plain
+        };
+        match kind % 16 {
+            0 => format!("{v:e}"),
+            1 => format!(" {plain}"),
+            2 => format!("\"{plain}\""),
+            3 => "x1".into(),
+            4 => String::new(),
+            5 => format!("+{}", plain.trim_start_matches('-')),
+            6 => format!("{}1234567890123", plain),
+            7 => plain.trim_start_matches(['-', '0']).to_string(),
+            8 => format!("{plain}."),
+            _ => plain,
+        }
+    }
+
+    /// Common rows are taken from the index, also right after lines of other forms (the index
+    /// resumes after them), until the last rows of the job (whose 16-byte loads would pass its
+    /// end); the values are the line-by-line ones.
+    #[test]
+    fn the_index_takes_the_common_rows() {
+        let mut body = String::new();
+        let mut common = 0;
+        for k in 0..3000 {
+            let t = format!("{}", f64::from(k) / 1e4);
+            if k % 97 == 5 {
+                body += &format!("{t},1e-3,2\n");
+            } else if k % 89 == 7 {
+                body += "\r\n";
+            } else {
+                body += &format!("{t},{}.{},-{}\r\n", k % 41, k % 1000, k % 7);
+                common += 1;
+            }
+        }
+        let text = format!("time_s,fx_N,fy_N\n{body}");
+        let r = RecordingReader::from_bytes("w.csv", text.as_bytes(), &ReadOptions::new())
+            .expect("header");
+        let p = r.row_parser();
+        let Some(w) = WideCells::detect() else { return };
+        let mut out = Parsed::default();
+        out.reset(r.info().columns.len());
+        // SAFETY: detected.
+        unsafe { parse_job_wide(w, &p, true, body.as_bytes(), &mut out) };
+        assert!(
+            out.indexed >= common - 1 && out.indexed <= common,
+            "{} of {common}",
+            out.indexed
+        );
+        let (scalar, wide) = both("time_s,fx_N,fy_N\n", &body);
+        assert!(scalar == wide && wide == summary(&out) && out.rows == 3000 - 34);
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
+
+        /// Jobs of common rows mixed with every other kind of line (exponents, blanks,
+        /// quotes, signs, long and empty cells, missing and extra fields, CRLF, a missing last
+        /// line end), with `.` and `,` decimals: the same rows, values, lines and first error.
+        #[test]
+        fn wide_job_equals_line_by_line(
+            rows in proptest::collection::vec(
+                (0u8..64, -2e4f64..2e4, 0usize..7, 0u8..40, proptest::bool::ANY), 1..400),
+            comma in proptest::bool::ANY,
+            last_end in proptest::bool::ANY,
+        ) {
+            let (delim, header) = if comma {
+                (";", "time_s;fx_N;fy_N\n")
+            } else {
+                (",", "time_s,fx_N,fy_N\n")
+            };
+            let mut body = String::new();
+            for (k, &(kind, v, d, line_kind, crlf)) in rows.iter().enumerate() {
+                let t = format!("{}", k as f64 / 100.0);
+                let t = if comma { t.replace('.', ",") } else { t };
+                // most lines common, as in recordings; the rest of every kind
+                let cells = [t, cell(kind, v, d, comma), cell(kind / 4, -v / 3.0, d, comma)];
+                let line = match line_kind {
+                    0 => String::new(),
+                    1 => cells[..2].join(delim),
+                    2 => format!("{}{delim}9", cells.join(delim)),
+                    3 => "   ".into(),
+                    _ => cells.join(delim),
+                };
+                body += &line;
+                body += if crlf { "\r\n" } else { "\n" };
+            }
+            if !last_end {
+                body.pop();
+            }
+            let (scalar, wide) = both(header, &body);
+            proptest::prop_assert_eq!(scalar, wide);
+        }
+
+        /// The structural index equals a byte-by-byte search, at any start and length.
+        #[test]
+        fn structurals_equal_a_byte_search(text in "[,;\n0-9a.]{0,300}", from in 0usize..70) {
+            let Some(w) = WideCells::detect() else { return Ok(()) };
+            let bytes = text.as_bytes();
+            let from = from.min(bytes.len());
+            let mut at = vec![0u32; bytes.len() - from + 64];
+            for delim in [b',', b';'] {
+                // SAFETY: detected.
+                let n = unsafe { w.structurals(bytes, from, bytes.len(), delim, &mut at) };
+                let want: Vec<u32> = bytes[from..]
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &c)| c == delim || c == b'\n')
+                    .map(|(k, _)| k as u32)
+                    .collect();
+                proptest::prop_assert_eq!(&at[..n], &want[..]);
+            }
+        }
+
+        /// A cell the wide parser takes has `parse_number`'s bits; plain cells up to 15 bytes
+        /// are always taken.
+        #[test]
+        fn number_cells_equal_parse_number(
+            cell in "[-+]?[0-9.,eE]{0,17}",
+            v in -1e6f64..1e6,
+            d in 0usize..9,
+            dc in proptest::bool::ANY,
+        ) {
+            let Some(w) = WideCells::detect() else { return Ok(()) };
+            for c in [cell.clone(), format!("{v:.d$}")] {
+                let mut bytes = c.clone().into_bytes();
+                bytes.extend_from_slice(&[b'\n'; 16]);
+                // SAFETY: detected.
+                let got = unsafe { w.number_cell(&bytes, 0, c.len(), dc) };
+                let want = crate::recording::text::parse_number(c.as_bytes(), dc);
+                if let Some(x) = got {
+                    proptest::prop_assert_eq!(Some(x.to_bits()), want.map(f64::to_bits), "{:?}", c);
+                }
+                let digits = c.strip_prefix(['-', '+']).unwrap_or(&c);
+                let plain = c.len() <= 15
+                    && digits.bytes().filter(|&x| x == b'.').count() <= 1
+                    && digits.bytes().all(|x| x.is_ascii_digit() || x == b'.')
+                    && digits.bytes().any(|x| x.is_ascii_digit());
+                if plain {
+                    proptest::prop_assert!(got.is_some(), "{:?}", c);
+                }
+            }
+        }
     }
 }
