@@ -64,9 +64,12 @@ struct Parsed {
     text: Vec<u8>,
     /// A mapped job's bytes in the map (its `text` is then empty).
     span: Option<(usize, usize)>,
-    /// Rows taken from the structural index (tests check the wide path is taken).
+    /// Rows taken from the structural index and stretches indexed (tests check the wide path
+    /// is taken, and not scanned again and again).
     #[cfg(test)]
     indexed: usize,
+    #[cfg(test)]
+    stretches: usize,
 }
 
 impl Parsed {
@@ -189,6 +192,8 @@ unsafe fn parse_job_wide(
                     fast = fast_misses < COMMON_MISSES || fast_misses * 8 < st.line;
                 }
                 IndexedRow::Unindexed => {}
+                // (indexing on would scan a stretch again for every such row)
+                IndexedRow::TooLong => fast = false,
             }
         }
         if !parse_job_line(p, has_time, bytes, &mut st, out) {
@@ -196,6 +201,10 @@ unsafe fn parse_job_wide(
         }
     }
     out.lines = st.line;
+    #[cfg(test)]
+    {
+        out.stretches = index.stretches;
+    }
 }
 
 /// Where a job's parse stands: the next line's first byte, the lines done, and whether common
@@ -300,6 +309,9 @@ struct StructuralIndex {
     from: usize,
     /// Cells per row.
     slots: usize,
+    /// Stretches indexed.
+    #[cfg(test)]
+    stretches: usize,
 }
 
 /// What the index made of the row at a position.
@@ -313,6 +325,8 @@ enum IndexedRow {
     /// The row's end is not indexed (a long line, or too close to the job's end for the
     /// wide loads): the line goes the scalar way, which does not count as another form.
     Unindexed,
+    /// The row is longer than a stretch of the index: the job's rows go the scalar way.
+    TooLong,
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -324,6 +338,8 @@ impl StructuralIndex {
             next: 0,
             from: usize::MAX,
             slots,
+            #[cfg(test)]
+            stretches: 0,
         }
     }
 
@@ -348,10 +364,19 @@ impl StructuralIndex {
             }
             let to = (pos + INDEX_BYTES).min(bytes.len());
             self.len = wide.structurals(bytes, pos, to, p.delim, &mut self.at);
+            #[cfg(test)]
+            {
+                self.stretches += 1;
+            }
             self.from = pos;
             self.next = 0;
             if self.slots > self.len {
-                return IndexedRow::Unindexed;
+                // a stretch cut short of a whole row: rows longer than a stretch
+                return if to < bytes.len() {
+                    IndexedRow::TooLong
+                } else {
+                    IndexedRow::Unindexed
+                };
             }
         }
         let ends = &self.at[self.next..self.next + self.slots];
@@ -848,8 +873,45 @@ mod wide_tests {
             "{} of {common}",
             out.indexed
         );
+        // each stretch indexed once (not again after every line taken the scalar way)
+        assert!(
+            out.stretches <= body.len() / INDEX_BYTES + 2,
+            "{}",
+            out.stretches
+        );
         let (scalar, wide) = both("time_s,fx_N,fy_N\n", &body);
         assert!(scalar == wide && wide == summary(&out) && out.rows == 3000 - 34);
+    }
+
+    /// Rows longer than a stretch of the index (thousands of channels) are parsed the scalar
+    /// way from the first one on, with the same results.
+    #[test]
+    fn rows_longer_than_a_stretch_go_the_scalar_way() {
+        let channels = INDEX_BYTES / 3;
+        let names: Vec<String> = (0..channels).map(|c| format!("c{c}")).collect();
+        let header = format!("time_s,{}\n", names.join(","));
+        let row = |k: usize| {
+            let cells: Vec<String> = (0..channels)
+                .map(|c| format!("{}.5", (c + k) % 97))
+                .collect();
+            format!("{},{}\n", k as f64 / 100.0, cells.join(","))
+        };
+        let body: String = (0..6).map(row).collect();
+        assert!(body.len() / 6 > INDEX_BYTES);
+        let text = format!("{header}{body}");
+        let r = RecordingReader::from_bytes("w.csv", text.as_bytes(), &ReadOptions::new())
+            .expect("header");
+        let p = r.row_parser();
+        let Some(w) = WideCells::detect() else { return };
+        let mut wide = Parsed::default();
+        wide.reset(r.info().columns.len());
+        let mut scalar = Parsed::default();
+        scalar.reset(r.info().columns.len());
+        // SAFETY: detected.
+        unsafe { parse_job_wide(w, &p, true, body.as_bytes(), &mut wide) };
+        parse_job_scalar(&p, true, body.as_bytes(), &mut scalar);
+        assert!(wide.indexed == 0 && wide.stretches == 1 && wide.rows == 6);
+        assert!(summary(&wide) == summary(&scalar));
     }
 
     proptest::proptest! {
