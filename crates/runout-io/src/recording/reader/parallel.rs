@@ -23,6 +23,13 @@ use std::sync::mpsc;
 /// Lines of a job that may fail the common-row path before the job may stop trying it.
 const COMMON_MISSES: u64 = 16;
 
+/// Whether a job whose `misses` lines (of `lines` so far) failed a fast path goes on trying it
+/// first: lines of another form go the full way, and when they are more than one in eight the
+/// job stops trying the fast path.
+fn keep_trying(misses: u64, lines: u64) -> bool {
+    misses < COMMON_MISSES || misses * 8 < lines
+}
+
 /// Bytes of input per job (cut at the next line end).
 const JOB_BYTES: usize = 1 << 20;
 
@@ -187,9 +194,8 @@ unsafe fn parse_job_wide(
                     for v in &mut out.values {
                         v.truncate(out.rows);
                     }
-                    // a job of other rows stops indexing as the common path stops (below)
                     fast_misses += 1;
-                    fast = fast_misses < COMMON_MISSES || fast_misses * 8 < st.line;
+                    fast = keep_trying(fast_misses, st.line);
                 }
                 IndexedRow::Unindexed => {}
                 // (indexing on would scan a stretch again for every such row)
@@ -253,10 +259,9 @@ fn parse_job_line(
         for v in &mut out.values {
             v.truncate(out.rows);
         }
-        // lines of another form (exponents, blanks, quotes) go the full way; when they are
-        // more than one in eight, the job stops trying the common path first
+        // lines of another form: exponents, blanks, quotes
         st.misses += 1;
-        st.common = st.misses < COMMON_MISSES || st.misses * 8 < st.line;
+        st.common = keep_trying(st.misses, st.line);
     }
     let (mut len, consumed) = match memchr::memchr(b'\n', rest) {
         Some(k) => (k, k + 1),
